@@ -1,0 +1,40 @@
+#pragma once
+// Input checks at the API boundary: each throws std::invalid_argument naming the field.
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "stokescontact/core/types.hpp"
+
+namespace stokescontact {
+
+[[noreturn]] inline void fail_argument(std::string_view field, std::string_view why) {
+  throw std::invalid_argument(std::string(field) + ": " + std::string(why));
+}
+
+inline void require_finite(double value, std::string_view field) {
+  if (!std::isfinite(value)) fail_argument(field, "must be finite, got " + std::to_string(value));
+}
+
+template <typename Derived>
+void require_finite(const Eigen::DenseBase<Derived>& value, std::string_view field) {
+  if (!value.allFinite()) {
+    std::ostringstream os;
+    os << "must be finite, got [" << value.transpose() << "]";
+    fail_argument(field, os.str());
+  }
+}
+
+inline void require_positive(double value, std::string_view field) {
+  require_finite(value, field);
+  if (!(value > 0.0)) fail_argument(field, "must be > 0, got " + std::to_string(value));
+}
+
+inline void require_non_negative(double value, std::string_view field) {
+  require_finite(value, field);
+  if (!(value >= 0.0)) fail_argument(field, "must be >= 0, got " + std::to_string(value));
+}
+
+}  // namespace stokescontact

@@ -1,0 +1,39 @@
+#pragma once
+// Rigid-body pose: centre x and unit quaternion q (Broms eq. 1), body <-> world maps.
+#include <cmath>
+#include <string>
+
+#include "stokescontact/core/errors.hpp"
+#include "stokescontact/core/types.hpp"
+
+namespace stokescontact {
+
+// A quaternion counts as unit length when | |q| - 1 | <= this tolerance.
+inline constexpr double kUnitQuaternionTolerance = 1e-10;
+
+struct Pose {
+  Vec3 x = Vec3::Zero();
+  Quat q = Quat::Identity();
+
+  Mat3 rotation() const { return q.toRotationMatrix(); }
+  Vec3 to_world(const Vec3& body_point) const { return x + q * body_point; }
+  Vec3 to_body(const Vec3& world_point) const { return q.conjugate() * (world_point - x); }
+  Vec3 direction_to_world(const Vec3& body_direction) const { return q * body_direction; }
+};
+
+inline void require_unit(const Quat& q, std::string_view field) {
+  require_finite(q.coeffs(), field);
+  const double norm = q.norm();
+  if (std::abs(norm - 1.0) > kUnitQuaternionTolerance)
+    fail_argument(field, "must be a unit quaternion (| |q| - 1 | <= 1e-10), got |q| = " +
+                             std::to_string(norm));
+}
+
+// Throws std::invalid_argument naming "pose.x" or "pose.q" when the pose is unusable.
+inline void validate(const Pose& pose, std::string_view name = "pose") {
+  const std::string prefix(name);
+  require_finite(pose.x, prefix + ".x");
+  require_unit(pose.q, prefix + ".q");
+}
+
+}  // namespace stokescontact

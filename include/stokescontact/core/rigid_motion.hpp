@@ -1,0 +1,52 @@
+#pragma once
+// The map Psi from body velocities (u, omega) to coordinate rates (Broms eq. 4) and the
+// forward-Euler step x' = x + dt u, q' = exp(dt omega / 2) q that keeps q unit length.
+#include <cmath>
+
+#include "stokescontact/core/pose.hpp"
+
+namespace stokescontact {
+
+using Psi = Eigen::Matrix<double, 7, 6>;
+
+// Coordinate rates d(x, q)/dt = Psi(q) (u, omega), with dq/dt = (1/2) [0, omega] q and
+// omega the angular velocity in the world frame; q stored as (w, x, y, z) rows 3..6.
+inline Psi psi_matrix(const Quat& q) {
+  Psi psi = Psi::Zero();
+  psi.topLeftCorner<3, 3>().setIdentity();
+  const double w = q.w();
+  const Vec3 v = q.vec();
+  psi.block<1, 3>(3, 3) = -0.5 * v.transpose();  // d(w)/dt = -(1/2) omega . v
+  Mat3 v_cross;
+  v_cross << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  psi.block<3, 3>(4, 3) = 0.5 * (w * Mat3::Identity() - v_cross);  // d(v)/dt
+  return psi;
+}
+
+// Unit quaternion exp([0, theta]) for a rotation vector theta (angle |theta| * 2 / 2):
+// the rotation by angle |phi| about phi / |phi| where phi = 2 theta.
+inline Quat quaternion_exp(const Vec3& half_rotation) {
+  const double angle = half_rotation.norm();
+  // sin(a)/a by its Taylor series near 0, where the division loses accuracy.
+  const double sinc = angle < 1e-4 ? 1.0 - angle * angle / 6.0 : std::sin(angle) / angle;
+  Quat e;
+  e.w() = std::cos(angle);
+  e.vec() = sinc * half_rotation;
+  return e;
+}
+
+// One step of the rigid motion with constant (u, omega) over dt: the exact rotation by
+// omega dt, renormalised so that rounding never accumulates into |q| != 1.
+inline Pose advance(const Pose& pose, const Vec3& u, const Vec3& omega, double dt) {
+  validate(pose);
+  require_finite(u, "u");
+  require_finite(omega, "omega");
+  require_finite(dt, "dt");
+  Pose next;
+  next.x = pose.x + dt * u;
+  next.q = quaternion_exp(0.5 * dt * omega) * pose.q;
+  next.q.normalize();
+  return next;
+}
+
+}  // namespace stokescontact

@@ -1,0 +1,350 @@
+#pragma once
+// Broad phase: every body pair whose bounding balls come within a cutoff, found with a cell
+// list in O(N) for bounded density; open space or an orthorhombic periodic box.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <compare>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "stokescontact/core/errors.hpp"
+#include "stokescontact/core/types.hpp"
+
+namespace stokescontact {
+
+// The box [0, Lx) x [0, Ly) x [0, Lz), repeated periodically.
+struct PeriodicBox {
+  Vec3 lengths = Vec3::Ones();
+};
+
+// A candidate pair, i < j.
+struct BodyPair {
+  Eigen::Index i = 0;
+  Eigen::Index j = 0;
+  friend auto operator<=>(const BodyPair&, const BodyPair&) = default;
+};
+
+// x mapped into [0, length). fmod is exact, so only the shift of a negative remainder rounds.
+inline double wrap_coordinate(double x, double length) {
+  double r = std::fmod(x, length);
+  if (r < 0.0) r += length;
+  return r < length ? r : 0.0;  // -tiny + length may round up to length, i.e. 0 in the box
+}
+
+inline Vec3 wrap_into_box(const Vec3& x, const PeriodicBox& box) {
+  return {wrap_coordinate(x.x(), box.lengths.x()), wrap_coordinate(x.y(), box.lengths.y()),
+          wrap_coordinate(x.z(), box.lengths.z())};
+}
+
+namespace detail {
+// floor for |v| < 2^62, inline (std::floor is a library call without SSE4.1).
+inline std::int64_t floor_to_int(double v) {
+  const auto i = static_cast<std::int64_t>(v);
+  return i - (static_cast<double>(i) > v);
+}
+
+// The candidate test on raw positions (open) or positions wrapped into the box (periodic).
+template <bool Periodic>
+inline bool within_reach(const double* xi, const double* xj, double ri, double rj,
+                         double cutoff, const double* length) {
+  double d[3];
+  for (int k = 0; k < 3; ++k) {
+    d[k] = xi[k] - xj[k];
+    if constexpr (Periodic) {
+      if (d[k] > 0.5 * length[k]) d[k] -= length[k];
+      else if (d[k] < -0.5 * length[k]) d[k] += length[k];
+    }
+  }
+  const double reach = (ri + rj) + cutoff;
+  return d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= reach * reach;
+}
+}  // namespace detail
+
+// The candidate predicate: |x_i - x_j| (minimum image when periodic) <= r_i + r_j + cutoff.
+// CellList evaluates exactly this, bit for bit, so brute force over it is a reference.
+inline bool is_candidate_pair(const Vec3& xi, const Vec3& xj, double ri, double rj,
+                              double cutoff, const std::optional<PeriodicBox>& box = {}) {
+  if (!box) return detail::within_reach<false>(xi.data(), xj.data(), ri, rj, cutoff, nullptr);
+  const Vec3 wi = wrap_into_box(xi, *box), wj = wrap_into_box(xj, *box);
+  return detail::within_reach<true>(wi.data(), wj.data(), ri, rj, cutoff, box->lengths.data());
+}
+
+// Cell list over body centres and bounding radii. Cells are at least the largest interaction
+// range 2 max(r) + cutoff wide, and the grid holds at most 4N + 64 buckets: a side with more
+// cells folds onto itself (cell index mod buckets, neighbours taken cyclically), so far
+// outliers cost no memory and only add a few rejected checks. Each pair of neighbouring
+// buckets is visited once, so each body pair is tested once. Buffers persist across calls.
+class CellList {
+ public:
+  // All candidate pairs (i < j), lexicographically sorted; valid until the next call.
+  const std::vector<BodyPair>& find_pairs(const Mat3X& positions, const VecX& radii, double cutoff,
+                                          const std::optional<PeriodicBox>& box = {}) {
+    const double range = validate(positions, radii, cutoff, box);
+    raw_.clear();
+    pairs_.clear();
+    pair_checks_ = 0;
+    n_ = {0, 0, 0};
+    if (positions.cols() < 2) return pairs_;
+    build(positions, radii, range, box);
+    if (box) collect<true>(cutoff, box->lengths);
+    else collect<false>(cutoff, Vec3::Zero());
+    sort_pairs(positions.cols());
+    return pairs_;
+  }
+
+  // Equal bodies of bounding radius `radius`.
+  const std::vector<BodyPair>& find_pairs(const Mat3X& positions, double radius, double cutoff,
+                                          const std::optional<PeriodicBox>& box = {}) {
+    require_non_negative(radius, "radius");
+    equal_radii_.setConstant(positions.cols(), radius);
+    return find_pairs(positions, equal_radii_, cutoff, box);
+  }
+
+  // Predicate evaluations in the last query; stays O(N) for bounded density.
+  std::int64_t pair_checks() const { return pair_checks_; }
+  // Buckets per side of the last grid (0 when N < 2).
+  const std::array<std::int64_t, 3>& buckets_per_side() const { return n_; }
+
+ private:
+  static double validate(const Mat3X& x, const VecX& radii, double cutoff,
+                         const std::optional<PeriodicBox>& box) {
+    for (Eigen::Index i = 0; i < x.cols(); ++i)  // name the body, not the whole matrix
+      if (!x.col(i).allFinite()) fail_argument("positions", "column " + std::to_string(i) + " must be finite");
+    if (radii.size() != x.cols()) fail_argument("radii", "size must equal the number of positions");
+    for (Eigen::Index i = 0; i < radii.size(); ++i)
+      if (!(std::isfinite(radii[i]) && radii[i] >= 0.0))
+        fail_argument("radii", "entry " + std::to_string(i) + " must be finite and >= 0, got " +
+                                   std::to_string(radii[i]));
+    require_non_negative(cutoff, "cutoff");
+    const double rho_max = radii.size() > 0 ? radii.maxCoeff() : 0.0;
+    const double range = (rho_max + rho_max) + cutoff;  // same rounding order as within_reach
+    if (box) {
+      for (int k = 0; k < 3; ++k) require_positive(box->lengths[k], "PeriodicBox.lengths");
+      if (range > 0.5 * box->lengths.minCoeff())  // else the minimum image is ambiguous
+        fail_argument("PeriodicBox.lengths", "must be >= 2 (2 max radius + cutoff) = " +
+                                                 std::to_string(2.0 * range));
+    }
+    return range;
+  }
+
+  // Buckets per side: the natural cell counts, cut (smallest side first) to at most
+  // `budget` buckets in all.
+  static std::array<std::int64_t, 3> fit_buckets(const std::array<std::int64_t, 3>& cells,
+                                                 double budget) {
+    std::array<int, 3> order = {0, 1, 2};
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return cells[a] < cells[b]; });
+    std::array<std::int64_t, 3> n{};
+    for (int r = 0; r < 3; ++r) {
+      const double share = std::floor(std::pow(budget, 1.0 / (3 - r)) + 1e-9);
+      n[order[r]] = std::clamp(static_cast<std::int64_t>(share), std::int64_t{1}, cells[order[r]]);
+      budget /= static_cast<double>(n[order[r]]);
+    }
+    return n;
+  }
+
+  // Open space: cell c = K M + f with K = floor(x / H) for a power of two H (exact) and
+  // f = floor((x - K H) M / H), whose rounding (~1e-14 cells) does not grow with |x|; the
+  // cells H / M are then at least the range whatever the coordinates. K is clamped far out,
+  // where ulp(x) > H keeps distinct coordinates out of reach anyway.
+  void set_open_grid(double range) {
+    const double padded = std::max(range * (1 + 1e-12), 0x1p-900);  // the pad absorbs rounding
+    single_cell_ = !(padded <= 0x1p900);  // a reach near overflow: one cell holds everything
+    if (single_cell_) return;
+    int e = 0;
+    std::frexp(64.0 * padded, &e);
+    coarse_ = std::ldexp(1.0, e);  // H in (64, 128] ranges, so H / M is within 1.6% of the range
+    inv_coarse_ = std::ldexp(1.0, -e);
+    fine_ = static_cast<std::int64_t>(std::floor(coarse_ / padded));
+    fine_scale_ = static_cast<double>(fine_) * inv_coarse_;  // M / H, exact
+  }
+
+  // (K, f) of an open-space coordinate; c = K M + f with f in [-1, M].
+  std::pair<std::int64_t, std::int64_t> open_cell(double x) const {
+    const double t = x * inv_coarse_;  // exact: a power of two
+    if (!(std::abs(t) < 0x1p62)) return {x < 0 ? -(std::int64_t{1} << 62) : std::int64_t{1} << 62, 0};
+    const std::int64_t key = detail::floor_to_int(t);
+    return {key, detail::floor_to_int((x - static_cast<double>(key) * coarse_) * fine_scale_)};
+  }
+
+  // Bucket along side k: cell index mod n_[k] (a shift when the side is not folded).
+  std::int64_t side_bucket(int k, double x) const {
+    const std::int64_t n = n_[k];
+    const bool folded = n < cells_[k];
+    if (periodic_) {  // w * scale may round up to cells
+      const std::int64_t c = std::clamp(detail::floor_to_int(x * scale_[k]), std::int64_t{0}, cells_[k] - 1);
+      return folded ? c % n : c;
+    }
+    if (single_cell_) return 0;
+    const auto [key, f] = open_cell(x);
+    if (!folded) return (key - low_[k].first) * fine_ + (f - low_[k].second) + 2;  // c >= c(low) - 1
+    const std::int64_t key_mod = (key % n + n) % n;
+    return (key_mod * fine_ + f + n) % n;  // f >= -1: the sum is positive
+  }
+
+  void build(const Mat3X& x, const VecX& radii, double range, const std::optional<PeriodicBox>& box) {
+    const Eigen::Index count = x.cols();
+    periodic_ = box.has_value();
+    if (box) {
+      wrapped_.resize(3, count);
+      for (Eigen::Index i = 0; i < count; ++i) wrapped_.col(i) = wrap_into_box(x.col(i), *box);
+    } else {
+      set_open_grid(range);
+    }
+    const Mat3X& p = box ? wrapped_ : x;
+    for (int k = 0; k < 3; ++k) {
+      if (box) {  // w in [0, L) rounds by ~1e-16 L: the pad 4e-15 L keeps pairs in adjacent cells
+        const double length = box->lengths[k];
+        cells_[k] = static_cast<std::int64_t>(std::floor(length / (range * (1 + 1e-12) + 4e-15 * length)));
+      } else if (single_cell_) {
+        cells_[k] = 1;
+      } else {  // occupied span; +4 as (K, f) order may miss c by 1 at each end and an
+                // unfolded side must keep empty buckets between its ends
+        auto lo = open_cell(p(k, 0)), hi = lo;
+        for (Eigen::Index i = 1; i < count; ++i) {
+          const auto c = open_cell(p(k, i));
+          lo = std::min(lo, c), hi = std::max(hi, c);
+        }
+        const double span = static_cast<double>(hi.first - lo.first) * static_cast<double>(fine_) +
+                            static_cast<double>(hi.second - lo.second) + 1.0;
+        cells_[k] = static_cast<std::int64_t>(std::min(span + 4.0, 0x1p62));
+        low_[k] = lo;
+      }
+    }
+    n_ = fit_buckets(cells_, 4.0 * static_cast<double>(count) + 64.0);
+    if (box) {
+      for (int k = 0; k < 3; ++k) {  // a multiple of n, so the seam folds onto buckets n-1 | 0
+        cells_[k] = n_[k] * (cells_[k] / n_[k]);
+        scale_[k] = static_cast<double>(cells_[k]) / box->lengths[k];
+      }
+    }
+
+    // Counting sort of the bodies by bucket.
+    const std::int64_t buckets = n_[0] * n_[1] * n_[2];
+    bucket_.resize(static_cast<std::size_t>(count));
+    start_.assign(static_cast<std::size_t>(buckets + 1), 0);
+    for (Eigen::Index i = 0; i < count; ++i) {
+      const std::int64_t b = side_bucket(0, p(0, i)) + n_[0] * (side_bucket(1, p(1, i)) + n_[1] * side_bucket(2, p(2, i)));
+      bucket_[static_cast<std::size_t>(i)] = b;
+      ++start_[static_cast<std::size_t>(b + 1)];
+    }
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    id_.resize(static_cast<std::size_t>(count));
+    pos_.resize(3, count);
+    rad_.resize(count);
+    for (Eigen::Index i = 0; i < count; ++i) {
+      const Eigen::Index slot = start_[static_cast<std::size_t>(bucket_[static_cast<std::size_t>(i)])]++;
+      id_[static_cast<std::size_t>(slot)] = i;
+      pos_.col(slot) = p.col(i);
+      rad_[slot] = radii[i];
+    }
+    std::rotate(start_.rbegin(), start_.rbegin() + 1, start_.rend());  // back to bucket starts
+    start_[0] = 0;
+  }
+
+  // Distinct buckets within one of b, cyclically, along a side of n (fewer than 3 if n < 3).
+  static int neighbours(std::int64_t b, std::int64_t n, std::int64_t out[3]) {
+    const std::int64_t candidates[3] = {b == 0 ? n - 1 : b - 1, b, b + 1 == n ? 0 : b + 1};
+    int m = 0;
+    for (const std::int64_t c : candidates)
+      if (std::find(out, out + m, c) == out + m) out[m++] = c;
+    return m;
+  }
+
+  // Each unordered pair of neighbouring buckets once, from the lower index (rows of x-adjacent
+  // buckets compared first), so each body pair is tested once even on sides of 1 or 2 buckets.
+  // Bodies are in bucket order, x fastest: an inner run bx-1..bx+1 of a row is one range.
+  template <bool Periodic>
+  void collect(double cutoff, const Vec3& length) {
+    raw_.reserve(std::max(raw_.capacity(), 2 * static_cast<std::size_t>(pos_.cols())));
+    auto cross = [&](Eigen::Index begin, Eigen::Index end, Eigen::Index other, Eigen::Index other_end) {
+      pair_checks_ += (end - begin) * (other_end - other);
+      for (Eigen::Index a = begin; a < end; ++a)
+        for (Eigen::Index c = std::max(other, a + 1); c < other_end; ++c)
+          if (detail::within_reach<Periodic>(pos_.col(a).data(), pos_.col(c).data(), rad_[a], rad_[c],
+                                             cutoff, length.data())) {
+            const Eigen::Index i = id_[static_cast<std::size_t>(a)], j = id_[static_cast<std::size_t>(c)];
+            raw_.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
+          }
+    };
+    auto at = [&](std::int64_t bucket) { return start_[static_cast<std::size_t>(bucket)]; };
+    const std::int64_t sx = n_[0];
+    std::int64_t nx[3], ny[3], nz[3];
+    for (std::int64_t bz = 0; bz < n_[2]; ++bz) {
+      const int mz = neighbours(bz, n_[2], nz);
+      for (std::int64_t by = 0; by < n_[1]; ++by) {
+        const int my = neighbours(by, n_[1], ny);
+        const std::int64_t row = by + n_[1] * bz;
+        for (std::int64_t bx = 0; bx < sx; ++bx) {
+          const std::int64_t b = bx + sx * row;
+          const Eigen::Index begin = at(b), end = at(b + 1);
+          if (begin == end) continue;
+          const int mx = neighbours(bx, sx, nx);
+          const bool inner = bx >= 1 && bx + 1 < sx;
+          cross(begin, end, begin, end);  // within the bucket: c > a
+          pair_checks_ -= (end - begin) * (end - begin + 1) / 2;  // counted pairs c > a only
+          for (int z = 0; z < mz; ++z)
+            for (int y = 0; y < my; ++y) {
+              const std::int64_t other = ny[y] + n_[1] * nz[z];
+              if (other < row) continue;
+              if (other == row || !inner) {
+                for (int x = 0; x < mx; ++x)
+                  if (other > row || nx[x] > bx) cross(begin, end, at(nx[x] + sx * other), at(nx[x] + sx * other + 1));
+              } else {
+                cross(begin, end, at(bx - 1 + sx * other), at(bx + 2 + sx * other));
+              }
+            }
+        }
+      }
+    }
+  }
+
+  // Counting sort by i, then a (short) sort of each i's partners: O(pairs + N).
+  void sort_pairs(Eigen::Index count) {
+    first_.assign(static_cast<std::size_t>(count + 1), 0);
+    for (const BodyPair& q : raw_) ++first_[static_cast<std::size_t>(q.i + 1)];
+    std::partial_sum(first_.begin(), first_.end(), first_.begin());
+    pairs_.resize(raw_.size());
+    for (const BodyPair& q : raw_) pairs_[static_cast<std::size_t>(first_[static_cast<std::size_t>(q.i)]++)] = q;
+    auto begin = pairs_.begin();  // first_[i] is now the end of i's run
+    for (Eigen::Index i = 0; i < count; ++i) {
+      const auto end = pairs_.begin() + first_[static_cast<std::size_t>(i)];
+      std::sort(begin, end);
+      begin = end;
+    }
+  }
+
+  std::vector<BodyPair> raw_, pairs_;  // found in bucket order; sorted
+  std::int64_t pair_checks_ = 0;
+  std::array<std::int64_t, 3> n_{}, cells_{};  // buckets and (unfolded) cells per side
+  std::array<double, 3> scale_{};              // periodic: cells per unit length
+  bool periodic_ = false, single_cell_ = false;
+  double coarse_ = 1.0, inv_coarse_ = 1.0;     // open: H, a power of two, and 1 / H
+  std::int64_t fine_ = 1;                      // open: M cells per H
+  double fine_scale_ = 1.0;                    // open: M / H
+  std::array<std::pair<std::int64_t, std::int64_t>, 3> low_{};  // open: least (K, f) per side
+  VecX equal_radii_, rad_;                    // rad_: radii in bucket order
+  Mat3X wrapped_, pos_;                       // pos_: positions in bucket order
+  std::vector<std::int64_t> bucket_, start_;  // bucket of each body; first body of each bucket
+  std::vector<Eigen::Index> id_, first_;      // body id in bucket order; pair runs by i
+};
+
+// One-shot query; see CellList::find_pairs.
+inline std::vector<BodyPair> candidate_pairs(const Mat3X& positions, const VecX& radii, double cutoff,
+                                             const std::optional<PeriodicBox>& box = {}) {
+  CellList cells;
+  return cells.find_pairs(positions, radii, cutoff, box);
+}
+
+inline std::vector<BodyPair> candidate_pairs(const Mat3X& positions, double radius, double cutoff,
+                                             const std::optional<PeriodicBox>& box = {}) {
+  CellList cells;
+  return cells.find_pairs(positions, radius, cutoff, box);
+}
+
+}  // namespace stokescontact

@@ -1,0 +1,48 @@
+#pragma once
+// The mobility operator: the only view of hydrodynamics the contact code has.
+// Given the poses of N rigid bodies and stacked forces (and torques) F, a model returns
+// the stacked velocities (and angular velocities) U = M F (Broms Sec. 1.1, Yan Sec. III.A).
+//
+// Layout: body i owns entries [i * d, (i + 1) * d) with d = dofs_per_body(): d = 6 stacks
+// (force, torque) -> (velocity, angular velocity), world frame; d = 3 is a translation-only
+// model for scenes that never need torques (spheres pushed through their centres).
+// Every model shipped is symmetric positive definite by construction.
+#include <concepts>
+#include <cstddef>
+#include <span>
+
+#include "stokescontact/core/pose.hpp"
+#include "stokescontact/core/types.hpp"
+
+namespace stokescontact {
+
+// What contact code needs from any model, including one a user writes.
+template <typename M>
+concept MobilityOperator = requires(M& m, const M& cm, std::span<const Pose> poses, const VecX& F) {
+  { m.set_configuration(poses) };                              // new poses, same bodies
+  { m.apply(F) } -> std::convertible_to<VecX>;                  // U = M F, counts one application
+  { cm.size() } -> std::convertible_to<Eigen::Index>;           // rows of M = N * dofs_per_body()
+  { cm.dofs_per_body() } -> std::convertible_to<int>;           // 3 or 6
+  { cm.applications() } -> std::convertible_to<std::size_t>;    // applications since the last reset
+  { m.reset_applications() };
+};
+
+// A model that can give its dense matrix cheaply (one call counts as size() applications
+// when the matrix is assembled column by column, as 0 when it is formed directly).
+template <typename M>
+concept DenseMobilityOperator = MobilityOperator<M> && requires(M& m) {
+  { m.dense_matrix() } -> std::convertible_to<MatX>;
+};
+
+// Counts applications for a model: the cost unit the papers compare.
+class ApplicationCounter {
+ public:
+  void count(std::size_t n = 1) { applications_ += n; }
+  std::size_t applications() const { return applications_; }
+  void reset_applications() { applications_ = 0; }
+
+ private:
+  std::size_t applications_ = 0;
+};
+
+}  // namespace stokescontact

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# The test command: installs what is missing, builds with warnings as errors and runs the
+# default test suite. `scripts/test.sh sanitize` does the same in the address+undefined
+# sanitizer build; `scripts/test.sh release -L long` passes extra arguments to ctest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+preset=${1:-release}
+shift || true
+scripts/install-deps.sh
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake --preset "$preset"
+cmake --build --preset "$preset" -j "$jobs"
+ctest --preset "$preset" -j "$jobs" "$@"
