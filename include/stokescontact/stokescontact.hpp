@@ -4,22 +4,48 @@
 
 // core
 #include "stokescontact/core/errors.hpp"
+#include "stokescontact/core/gmres.hpp"
 #include "stokescontact/core/pose.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 #include "stokescontact/core/types.hpp"
 
 // geometry
+#include "stokescontact/geometry/arc_distance.hpp"
 #include "stokescontact/geometry/broad_phase.hpp"
 #include "stokescontact/geometry/centre_curve.hpp"
+#include "stokescontact/geometry/closest_points.hpp"
 #include "stokescontact/geometry/mass_tensors.hpp"
 #include "stokescontact/geometry/point_distance.hpp"
 #include "stokescontact/geometry/primitives.hpp"
+#include "stokescontact/geometry/segment_distance.hpp"
 #include "stokescontact/geometry/shapes.hpp"
 #include "stokescontact/geometry/surface_nodes.hpp"
 
 // mobility
+#include "stokescontact/mobility/blob_model.hpp"
+#include "stokescontact/mobility/blob_models.hpp"
+#include "stokescontact/mobility/blob_rpy.hpp"
+#include "stokescontact/mobility/boomerang_blobs.hpp"
+#include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/mobility_operator.hpp"
+#include "stokescontact/mobility/multiblob_mobility.hpp"
+#include "stokescontact/mobility/multiblob_saddle_point.hpp"
+#include "stokescontact/mobility/pair_mobility_exact.hpp"
+#include "stokescontact/mobility/rigidity_matrix.hpp"
+#include "stokescontact/mobility/rod_blobs.hpp"
 #include "stokescontact/mobility/rpy_kernel.hpp"
+#include "stokescontact/mobility/rpy_mobility.hpp"
+#include "stokescontact/mobility/rpy_rotation_kernel.hpp"
+#include "stokescontact/mobility/single_body_mobility.hpp"
+#include "stokescontact/mobility/sphere_shell.hpp"
+
+// contact
+#include "stokescontact/contact/barrier.hpp"
+#include "stokescontact/contact/contact_matrix.hpp"
+#include "stokescontact/contact/contact_pairs.hpp"
+#include "stokescontact/contact/d_try.hpp"
+#include "stokescontact/contact/scene.hpp"
+#include "stokescontact/contact/surface_contacts.hpp"
 
 // io
 #include "stokescontact/io/json.hpp"

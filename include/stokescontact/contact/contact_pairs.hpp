@@ -1,0 +1,148 @@
+#pragma once
+// Contact detection at the trial configuration (Broms & Tornberg Sec. 2.1, 2.3): every body
+// pair (i, j) with particle distance d^P <= d_try, with its closest points, found through
+// the broad phase (bounding balls within d_try) and then exact closest points. In a
+// periodic box body j enters through its minimum image about body i; for a flagged pair
+// that image is the only one within reach (the broad phase requires box sides of at least
+// 2 (2 max bounding radius + d_try)).
+//
+// Also the smallest d^P over all pairs of a configuration, the measure the solvers report
+// against d_hat.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "stokescontact/contact/scene.hpp"
+#include "stokescontact/geometry/broad_phase.hpp"
+#include "stokescontact/geometry/closest_points.hpp"
+
+namespace stokescontact {
+
+// A flagged pair, i < j. The closest points run from body i to the image of body j at
+// x_j + image_shift (image_shift = 0 in open space), normal from i towards j.
+struct ContactPair {
+  Eigen::Index i = 0;
+  Eigen::Index j = 0;
+  Vec3 image_shift = Vec3::Zero();
+  ClosestPoints points;
+};
+
+// The lattice vector that takes x_j to its image nearest x_i (zero without a box).
+inline Vec3 minimum_image_shift(const Vec3& x_i, const Vec3& x_j, const std::optional<PeriodicBox>& box) {
+  if (!box) return Vec3::Zero();
+  const Vec3 d = x_j - x_i;
+  Vec3 shift;
+  for (int k = 0; k < 3; ++k) shift[k] = -box->lengths[k] * std::round(d[k] / box->lengths[k]);
+  return shift;
+}
+
+inline Pose shifted(const Pose& pose, const Vec3& shift) { return {pose.x + shift, pose.q}; }
+
+namespace detail {
+
+template <Shape S>
+void broad_phase_input(std::span<const S> shapes, std::span<const Pose> poses, Mat3X& centres, VecX& radii) {
+  const auto n = static_cast<Eigen::Index>(poses.size());
+  centres.resize(3, n);
+  radii.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    centres.col(k) = poses[static_cast<std::size_t>(k)].x;
+    radii[k] = bounding_radius(shape_of(shapes, static_cast<std::size_t>(k)));
+  }
+}
+
+template <Shape S>
+ContactPair contact_pair(std::span<const S> shapes, std::span<const Pose> poses, Eigen::Index i, Eigen::Index j,
+                         const std::optional<PeriodicBox>& box) {
+  const auto si = static_cast<std::size_t>(i), sj = static_cast<std::size_t>(j);
+  ContactPair pair{i, j, minimum_image_shift(poses[si].x, poses[sj].x, box), {}};
+  pair.points = closest_points(shape_of(shapes, si), poses[si], shape_of(shapes, sj), shifted(poses[sj], pair.image_shift));
+  return pair;
+}
+
+}  // namespace detail
+
+// All pairs with d^P <= d_try (d_try >= 0), sorted by (i, j). `cells`, when given, keeps
+// the broad phase's buffers between calls.
+template <Shape S>
+std::vector<ContactPair> find_contact_pairs(std::span<const S> shapes, std::span<const Pose> poses, double d_try,
+                                            const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
+  validate_scene(shapes, poses);
+  require_non_negative(d_try, "d_try");
+  Mat3X centres;
+  VecX radii;
+  detail::broad_phase_input(shapes, poses, centres, radii);
+  CellList local;
+  CellList& list = cells != nullptr ? *cells : local;
+  std::vector<ContactPair> flagged;
+  for (const BodyPair& c : list.find_pairs(centres, radii, d_try, box)) {
+    ContactPair pair = detail::contact_pair(shapes, poses, c.i, c.j, box);
+    if (pair.points.distance <= d_try) flagged.push_back(pair);
+  }
+  return flagged;
+}
+
+template <Shape S>
+std::vector<ContactPair> find_contact_pairs(const S& shape, std::span<const Pose> poses, double d_try,
+                                            const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
+  return find_contact_pairs(std::span<const S>(&shape, 1), poses, d_try, box, cells);
+}
+
+// The pair with the smallest d^P; distance = +infinity (i = j = -1) for fewer than 2 bodies.
+struct MinimumDistance {
+  double distance = std::numeric_limits<double>::infinity();
+  Eigen::Index i = -1;
+  Eigen::Index j = -1;
+};
+
+// Smallest d^P over all pairs: broad-phase queries with a growing cutoff (starting from the
+// largest bounding radius, times 4 per round) until a pair lies within the cutoff, which is
+// then the minimum. Open space ends at the latest once the cutoff spans all centres. In a
+// periodic box the cutoff stops at the broad phase's reach, L_min/2 - 2 max bounding radius;
+// if no pair lies within it, every pair is farther apart than that and the result is the
+// minimum over all pairs' minimum images (found by brute force).
+template <Shape S>
+MinimumDistance minimum_pair_distance(std::span<const S> shapes, std::span<const Pose> poses,
+                                      const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
+  validate_scene(shapes, poses);
+  MinimumDistance best;
+  if (poses.size() < 2) return best;
+  Mat3X centres;
+  VecX radii;
+  detail::broad_phase_input(shapes, poses, centres, radii);
+  const double r_max = radii.maxCoeff();
+  // Largest cutoff needed: open space, the span of the centres (every pair is then a
+  // candidate); periodic, the broad phase's reach.
+  double reach = (centres.rowwise().maxCoeff() - centres.rowwise().minCoeff()).norm();
+  if (box) {
+    const double half = 0.5 * box->lengths.minCoeff();
+    reach = std::max(0.0, half - (r_max + r_max));
+    while (reach > 0.0 && (r_max + r_max) + reach > half) reach = std::nextafter(reach, 0.0);
+  }
+  auto consider = [&](Eigen::Index i, Eigen::Index j) {
+    const double d = detail::contact_pair(shapes, poses, i, j, box).points.distance;
+    if (d < best.distance) best = {d, i, j};
+  };
+  CellList local;
+  CellList& list = cells != nullptr ? *cells : local;
+  for (double cutoff = std::min(r_max, reach);; cutoff = std::min(4.0 * cutoff, reach)) {
+    for (const BodyPair& c : list.find_pairs(centres, radii, cutoff, box)) consider(c.i, c.j);
+    if (best.distance <= cutoff || (!box && cutoff == reach)) return best;
+    if (cutoff == reach) break;
+  }
+  const auto n = static_cast<Eigen::Index>(poses.size());  // periodic, nothing within reach
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = i + 1; j < n; ++j) consider(i, j);
+  return best;
+}
+
+template <Shape S>
+MinimumDistance minimum_pair_distance(const S& shape, std::span<const Pose> poses,
+                                      const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
+  return minimum_pair_distance(std::span<const S>(&shape, 1), poses, box, cells);
+}
+
+}  // namespace stokescontact

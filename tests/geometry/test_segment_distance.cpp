@@ -1,0 +1,213 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "geometry/brute_force.hpp"
+#include "stokescontact/geometry/segment_distance.hpp"
+
+namespace sc = stokescontact;
+using sc::Segment;
+using sc::Vec3;
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+// Every case runs at these length scales; errors are judged relative to the scale.
+constexpr double kScales[] = {1e-6, 1.0, 1e6};
+
+Segment scaled(const Segment& s, double k) { return {k * s.p0, k * s.p1}; }
+
+// The result is self-consistent: parameters in [0, 1], points on their segments, and the
+// distance is the points' separation.
+void expect_consistent(const Segment& a, const Segment& b, const sc::PieceClosestPoints& c, double scale) {
+  EXPECT_GE(c.parameter_a, 0.0);
+  EXPECT_LE(c.parameter_a, 1.0);
+  EXPECT_GE(c.parameter_b, 0.0);
+  EXPECT_LE(c.parameter_b, 1.0);
+  EXPECT_LE((c.point_a - a.point(c.parameter_a)).norm(), 4 * kEps * scale);
+  EXPECT_LE((c.point_b - b.point(c.parameter_b)).norm(), 4 * kEps * scale);
+  EXPECT_NEAR((c.point_b - c.point_a).norm(), c.distance, 4 * kEps * scale);
+}
+
+// Checks distance (to `tol` units of rounding at the scale) and, where given, parameters.
+void expect_case(const Segment& a0, const Segment& b0, double distance0, double tol = 8.0,
+                 double s = -1.0, double t = -1.0) {
+  for (const double k : kScales) {
+    SCOPED_TRACE(testing::Message() << "scale " << k);
+    const Segment a = scaled(a0, k), b = scaled(b0, k);
+    const sc::PieceClosestPoints c = sc::closest_points(a, b);
+    EXPECT_NEAR(c.distance, k * distance0, tol * kEps * k);
+    if (s >= 0.0) {
+      EXPECT_NEAR(c.parameter_a, s, 1e-12);
+    }
+    if (t >= 0.0) {
+      EXPECT_NEAR(c.parameter_b, t, 1e-12);
+    }
+    expect_consistent(a, b, c, k);
+    // Swapping the arguments mirrors the result.
+    const sc::PieceClosestPoints r = sc::closest_points(b, a);
+    EXPECT_NEAR(r.distance, c.distance, tol * kEps * k);
+  }
+}
+
+}  // namespace
+
+TEST(SegmentDistance, Parallel) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.3, 1, 0), Vec3(2, 1, 0)}, 1.0);
+}
+
+TEST(SegmentDistance, Antiparallel) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(2, 1, 0), Vec3(0.3, 1, 0)}, 1.0);
+}
+
+TEST(SegmentDistance, ParallelWithoutOverlapMeetsAtEnds) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(2, 1, 0), Vec3(3, 1, 0)}, std::sqrt(2.0), 8.0,
+              1.0, 0.0);
+}
+
+TEST(SegmentDistance, CollinearOverlapping) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 0), Vec3(2, 0, 0)}, 0.0);
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(2, 0, 0), Vec3(-1, 0, 0)}, 0.0);  // contains a
+}
+
+TEST(SegmentDistance, CollinearDisjoint) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(3, 0, 0), Vec3(1.5, 0, 0)}, 0.5, 8.0, 1.0, 1.0);
+}
+
+TEST(SegmentDistance, CollinearTouchingEnds) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(1, 0, 0), Vec3(2, 0, 0)}, 0.0, 8.0, 1.0, 0.0);
+}
+
+TEST(SegmentDistance, Crossing) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.25, -1, 0), Vec3(0.25, 3, 0)}, 0.0, 8.0, 0.25,
+              0.25);
+}
+
+TEST(SegmentDistance, TJunction) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 0), Vec3(0.5, 1, 0)}, 0.0, 8.0, 0.5, 0.0);
+}
+
+TEST(SegmentDistance, SkewPerpendicular) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, -1, 2), Vec3(0.5, 1, 2)}, 2.0, 8.0, 0.5, 0.5);
+}
+
+TEST(SegmentDistance, SkewWithClampedInteriorSolution) {
+  // The lines' closest points lie beyond b's end: the minimum is at t = 1.
+  expect_case({Vec3(0, 0, 0), Vec3(4, 0, 0)}, {Vec3(1, 3, 1), Vec3(2, 2, 1)}, std::sqrt(5.0), 8.0,
+              0.5, 1.0);
+}
+
+TEST(SegmentDistance, ZeroLengthFirst) {
+  expect_case({Vec3(0.5, 2, 0), Vec3(0.5, 2, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 2.0, 8.0, 0.0, 0.5);
+  expect_case({Vec3(-3, 4, 0), Vec3(-3, 4, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 5.0, 8.0, 0.0, 0.0);
+}
+
+TEST(SegmentDistance, ZeroLengthSecond) {
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 2), Vec3(0.5, 0, 2)}, 2.0, 8.0, 0.5, 0.0);
+}
+
+TEST(SegmentDistance, ZeroLengthBoth) {
+  expect_case({Vec3(1, 2, 3), Vec3(1, 2, 3)}, {Vec3(1, 2, 5), Vec3(1, 2, 5)}, 2.0);
+  expect_case({Vec3(1, 2, 3), Vec3(1, 2, 3)}, {Vec3(1, 2, 3), Vec3(1, 2, 3)}, 0.0);
+}
+
+TEST(SegmentDistance, ZeroLengthOnSegment) {
+  expect_case({Vec3(0.25, 0, 0), Vec3(0.25, 0, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 0.0, 8.0, 0.0, 0.25);
+}
+
+TEST(SegmentDistance, AlmostZeroLength) {
+  // A segment 1e-13 long behaves as the point it nearly is.
+  expect_case({Vec3(0.5, 2, 0), Vec3(0.5 + 1e-13, 2, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 2.0);
+}
+
+// Lines in the planes z = 0 and z = h crossing (in projection) at the origin at angle theta:
+// the distance is exactly h for every theta, while the crossing's location along the lines
+// becomes ill-conditioned as theta -> 0. The distance must stay exact to rounding.
+TEST(SegmentDistance, NearlyParallelCrossingInProjection) {
+  for (const double theta : {1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12}) {
+    for (const double h : {0.0, 1e-9, 1e-3, 0.5}) {
+      SCOPED_TRACE(testing::Message() << "theta " << theta << " h " << h);
+      const Vec3 d(std::cos(theta), std::sin(theta), 0.0);
+      expect_case({Vec3(-1, 0, 0), Vec3(1, 0, 0)}, {Vec3(0, 0, h) - 0.7 * d, Vec3(0, 0, h) + 1.3 * d}, h);
+    }
+  }
+}
+
+// Nearly parallel, overlapping, b starting above a's interior and drifting away by theta:
+// the minimum h sits at b's first end.
+TEST(SegmentDistance, NearlyParallelOverlapping) {
+  for (const double theta : {1e-4, 1e-8, 1e-12}) {
+    SCOPED_TRACE(testing::Message() << "theta " << theta);
+    // Below theta ~ 1e-7 every point of the overlap ties within rounding: no parameter check.
+    const bool distinct = theta > 1e-7;
+    expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 0.25), Vec3(1.5, theta, 0.25)}, 0.25, 8.0,
+                distinct ? 0.5 : -1.0, distinct ? 0.0 : -1.0);
+    // Drifting towards a instead, within a's span: the minimum is at b's second end.
+    expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.2, 0, 0.25), Vec3(0.8, 0, 0.25 - theta)},
+                0.25 - theta, 8.0, 0.8, 1.0);
+  }
+}
+
+TEST(SegmentDistance, NearlyParallelEndToEnd) {
+  for (const double theta : {1e-6, 1e-12}) {
+    expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(1.5, 0, 0), Vec3(2.5, theta, 0)}, 0.5, 8.0, 1.0, 0.0);
+  }
+}
+
+TEST(SegmentDistance, VeryDifferentLengths) {
+  expect_case({Vec3(0, 0, 0), Vec3(1e6, 0, 0)}, {Vec3(3, 1, 0.5), Vec3(3, 1, 0.5 + 1e-6)}, std::hypot(1.0, 0.5),
+              1e7);  // rounding relative to a's length 1e6
+}
+
+// Random pairs at scales 1e-6 .. 1e6, general and nearly parallel, against the independent
+// brute force (which only bounds from above, and agrees after refinement).
+TEST(SegmentDistance, RandomPairsMatchBruteForce) {
+  brute_force::Rng rng(20240611);
+  const int n = brute_force::random_pairs(20000);
+  int failures = 0;
+  for (int i = 0; i < n; ++i) {
+    const double scale = std::pow(10.0, brute_force::uniform(rng, -6.0, 6.0));
+    const Vec3 origin = scale * Vec3(brute_force::uniform(rng, -3, 3), brute_force::uniform(rng, -3, 3),
+                                     brute_force::uniform(rng, -3, 3));
+    const Segment a{origin, origin + scale * brute_force::uniform(rng, 0, 2) * brute_force::random_unit_vector(rng)};
+    Segment b;
+    if (i % 3 == 0) {  // nearly parallel to a, tilted by up to 1e-3 .. 1e-12 rad
+      const Vec3 dir = (a.p1 - a.p0).normalized();
+      const Vec3 tilt = brute_force::random_unit_vector(rng).cross(dir) *
+                        std::pow(10.0, brute_force::uniform(rng, -12, -3));
+      const Vec3 start = a.point(brute_force::uniform(rng, -0.5, 1.5)) +
+                         scale * brute_force::uniform(rng, 0, 0.3) * brute_force::random_unit_vector(rng);
+      b = {start, start + scale * brute_force::uniform(rng, 0.1, 2) * (dir + tilt)};
+    } else {
+      const Vec3 start = origin + scale * Vec3(brute_force::uniform(rng, -1, 1), brute_force::uniform(rng, -1, 1),
+                                               brute_force::uniform(rng, -1, 1));
+      b = {start, start + scale * brute_force::uniform(rng, 0, 2) * brute_force::random_unit_vector(rng)};
+    }
+    const sc::PieceClosestPoints c = sc::closest_points(a, b);
+    const brute_force::Result ref =
+        brute_force::curve_distance(brute_force::as_curve(a), brute_force::as_curve(b));
+    const double tol = 1e-9 * scale;
+    const bool ok = c.distance <= ref.distance + 16 * kEps * scale && c.distance >= ref.distance - tol;
+    if (!ok) {
+      ADD_FAILURE() << "pair " << i << " scale " << scale << ": exact " << c.distance << " brute force "
+                    << ref.distance;
+      if (++failures > 5) break;
+    }
+    expect_consistent(a, b, c, 3 * scale);
+  }
+}
+
+// (a, b) and (b, a) run the same arithmetic unless the lengths tie: mirrored results.
+TEST(SegmentDistance, ArgumentOrderMirrorsExactly) {
+  brute_force::Rng rng(7);
+  for (int i = 0; i < 1000; ++i) {
+    const Segment a{brute_force::random_unit_vector(rng), 2.0 * brute_force::random_unit_vector(rng)};
+    const Segment b{brute_force::random_unit_vector(rng), -brute_force::random_unit_vector(rng)};
+    const sc::PieceClosestPoints ab = sc::closest_points(a, b), ba = sc::closest_points(b, a);
+    EXPECT_EQ(ab.distance, ba.distance);
+    EXPECT_EQ(ab.parameter_a, ba.parameter_b);
+    EXPECT_EQ(ab.parameter_b, ba.parameter_a);
+    EXPECT_EQ(ab.point_a, ba.point_b);
+  }
+}
