@@ -31,7 +31,8 @@ Vec3 random_in_ball(std::mt19937_64& rng, double radius) {
 
 Quat random_rotation(std::mt19937_64& rng) {
   for (;;) {
-    const Eigen::Vector4d v(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Eigen::Vector4d v(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
+                            uniform(rng, -1, 1));
     if (v.norm() > 0.1 && v.norm() < 1.0) return Quat(v[0], v[1], v[2], v[3]).normalized();
   }
 }

@@ -44,6 +44,10 @@
 #include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/contact/contact_pairs.hpp"
 #include "stokescontact/contact/d_try.hpp"
+#include "stokescontact/contact/lcp.hpp"
+#include "stokescontact/contact/lcp_apgd.hpp"
+#include "stokescontact/contact/lcp_bbpgd.hpp"
+#include "stokescontact/contact/lcp_minimum_map_newton.hpp"
 #include "stokescontact/contact/scene.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
 

@@ -41,9 +41,18 @@ Arc random_arc(brute_force::Rng& rng, double scale) {
 }
 
 Segment random_segment(brute_force::Rng& rng, double scale) {
-  const Vec3 p0 = scale * Vec3(brute_force::uniform(rng, -1.5, 1.5), brute_force::uniform(rng, -1.5, 1.5),
-                               brute_force::uniform(rng, -1.5, 1.5));
-  return {p0, p0 + scale * brute_force::uniform(rng, 0.0, 3.0) * brute_force::random_unit_vector(rng)};
+  const Vec3 p0 =
+      scale * Vec3(brute_force::uniform(rng, -1.5, 1.5), brute_force::uniform(rng, -1.5, 1.5),
+                   brute_force::uniform(rng, -1.5, 1.5));
+  return {p0,
+          p0 + scale * brute_force::uniform(rng, 0.0, 3.0) * brute_force::random_unit_vector(rng)};
+}
+
+Segment scaled(const Segment& s, double k) { return {k * s.p0, k * s.p1}; }
+Arc scaled(Arc a, double k) {
+  a.centre *= k;
+  a.radius *= k;
+  return a;
 }
 
 Vec3 point_on(const Segment& s, double p) { return s.point(p); }
@@ -65,15 +74,12 @@ void expect_consistent(const A& a, const B& b, const sc::PieceClosestPoints& c, 
 
 // Distance against a known value at several scales, both argument orders.
 template <typename A, typename B>
-void expect_distance(const A& a0, const B& b0, double expected, double tol = 64.0) {
+void expect_distance(const A& a0, const B& b0, double expected) {
+  constexpr double tol = 64.0;  // units of rounding at the scale
   for (const double k : {1e-6, 1.0, 1e6}) {
     SCOPED_TRACE(testing::Message() << "scale " << k);
-    A a = a0;
-    B b = b0;
-    if constexpr (std::is_same_v<A, Arc>) a.centre *= k, a.radius *= k;
-    else a = {k * a.p0, k * a.p1};
-    if constexpr (std::is_same_v<B, Arc>) b.centre *= k, b.radius *= k;
-    else b = {k * b.p0, k * b.p1};
+    const A a = scaled(a0, k);
+    const B b = scaled(b0, k);
     const sc::PieceClosestPoints c = sc::closest_points(a, b);
     EXPECT_NEAR(c.distance, k * expected, tol * kEps * k);
     expect_consistent(a, b, c, 4 * k);
@@ -86,11 +92,13 @@ void expect_distance(const A& a0, const B& b0, double expected, double tol = 64.
 template <typename A, typename B>
 int compare_with_brute_force(const A& a, const B& b, double scale, int index) {
   const sc::PieceClosestPoints c = sc::closest_points(a, b);
-  const brute_force::Result ref = brute_force::curve_distance(brute_force::as_curve(a), brute_force::as_curve(b));
+  const brute_force::Result ref =
+      brute_force::curve_distance(brute_force::as_curve(a), brute_force::as_curve(b));
   expect_consistent(a, b, c, 4 * scale);
-  if (c.distance <= ref.distance + 64 * kEps * scale && c.distance >= ref.distance - 1e-9 * scale) return 0;
-  ADD_FAILURE() << "pair " << index << " scale " << scale << ": exact " << c.distance << " brute force "
-                << ref.distance;
+  if (c.distance <= ref.distance + 64 * kEps * scale && c.distance >= ref.distance - 1e-9 * scale)
+    return 0;
+  ADD_FAILURE() << "pair " << index << " scale " << scale << ": exact " << c.distance
+                << " brute force " << ref.distance;
   return 1;
 }
 
@@ -101,6 +109,10 @@ TEST(ArcDistance, PointAgainstArcIsClosedForm) {
   const sc::PieceClosestPoints c = sc::closest_points(p, kQuarter);
   EXPECT_DOUBLE_EQ(c.distance, sc::closest_point(kQuarter, p.p0).distance);
   EXPECT_NEAR(c.parameter_b, 0.25 * kPi, 1e-15);
+  // So is a segment too short for its squared length to be a normal double.
+  const Segment tiny{Vec3(2, 2, 0), Vec3(2, 2, 1e-160)};
+  EXPECT_EQ(sc::closest_points(kQuarter, tiny).distance,
+            sc::closest_point(kQuarter, tiny.p0).distance);
 }
 
 TEST(ArcDistance, SegmentCrossingArc) {
@@ -113,12 +125,14 @@ TEST(ArcDistance, SegmentTangentToArc) {
   const double h = std::sqrt(0.5);
   expect_distance(Segment{Vec3(h - 1, h + 1, 0), Vec3(h + 1, h - 1, 0)}, kQuarter, 0.0);
   expect_distance(Segment{Vec3(h - 1, h + 1, 0.1), Vec3(h + 1, h - 1, 0.1)}, kQuarter, 0.1);
-  expect_distance(Segment{Vec3(h - 1, h + 1, 0), Vec3(h + 1, h - 1, 0)}, moved(kQuarter, Vec3(-0.25 * h, -0.25 * h, 0)), 0.25);
+  expect_distance(Segment{Vec3(h - 1, h + 1, 0), Vec3(h + 1, h - 1, 0)},
+                  moved(kQuarter, Vec3(-0.25 * h, -0.25 * h, 0)), 0.25);
 }
 
 TEST(ArcDistance, SegmentThroughCentreInPlane) {
   expect_distance(Segment{Vec3(-2, -2, 0), Vec3(2, 2, 0)}, kQuarter, 0.0);
-  expect_distance(Segment{Vec3(-2, -2, 0), Vec3(0.1, 0.1, 0)}, kQuarter, 1.0 - 0.1 * std::sqrt(2.0));
+  expect_distance(Segment{Vec3(-2, -2, 0), Vec3(0.1, 0.1, 0)}, kQuarter,
+                  1.0 - 0.1 * std::sqrt(2.0));
 }
 
 // Every arc point is the same distance from a segment on the axis: f is constant in t.
@@ -136,7 +150,8 @@ TEST(ArcDistance, SegmentNearestToAnArcEnd) {
 
 TEST(ArcDistance, SegmentInsideFullCircle) {
   const Arc circle{Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1.0, 2.0 * kPi};
-  expect_distance(Segment{Vec3(-0.3, 0.2, 0), Vec3(0.4, 0.2, 0)}, circle, 1.0 - std::hypot(0.4, 0.2));
+  expect_distance(Segment{Vec3(-0.3, 0.2, 0), Vec3(0.4, 0.2, 0)}, circle,
+                  1.0 - std::hypot(0.4, 0.2));
 }
 
 TEST(ArcDistance, ArcsCoaxialStacked) {
@@ -153,22 +168,23 @@ TEST(ArcDistance, ArcsConcentricCoplanar) {
 }
 
 TEST(ArcDistance, ArcsOnTheSameCircle) {
-  expect_distance(kQuarter, rotated_in_plane(kQuarter, 0.3), 0.0);                    // overlapping
-  expect_distance(kQuarter, rotated_in_plane(kQuarter, 0.5 * kPi), 0.0);              // end to end
-  expect_distance(kQuarter, rotated_in_plane(kQuarter, kPi), std::sqrt(2.0));         // disjoint
+  expect_distance(kQuarter, rotated_in_plane(kQuarter, 0.3), 0.0);             // overlapping
+  expect_distance(kQuarter, rotated_in_plane(kQuarter, 0.5 * kPi), 0.0);       // end to end
+  expect_distance(kQuarter, rotated_in_plane(kQuarter, kPi), std::sqrt(2.0));  // disjoint
   expect_distance(kQuarter, moved(rotated_in_plane(kQuarter, 0.3), Vec3(0, 0, 1e-9)), 1e-9);
 }
 
 TEST(ArcDistance, ArcsCrossing) {
   // Touching at an end of each: kQuarter's start (1, 0, 0).
-  const Arc vertical{Vec3(0.5, 0.5, 0), Vec3(1, -1, 0).normalized(), Vec3::UnitZ(), std::sqrt(0.5), 0.5 * kPi};
+  const Arc vertical{Vec3(0.5, 0.5, 0), Vec3(1, -1, 0).normalized(), Vec3::UnitZ(), std::sqrt(0.5),
+                     0.5 * kPi};
   expect_distance(kQuarter, vertical, 0.0);
   // A unit circle through the z axis and kQuarter's midpoint p, crossing it inside both arcs.
   const Vec3 p = Vec3(1, 1, 0).normalized();
   const double c = std::cos(0.3), s = std::sin(0.3);
   const Arc tilted{Vec3::Zero(), c * p - s * Vec3::UnitZ(), s * p + c * Vec3::UnitZ(), 1.0, 1.0};
   expect_distance(kQuarter, tilted, 0.0);
-  expect_distance(kQuarter, moved(tilted, 0.1 * p), 0.1);           // pushed out along p
+  expect_distance(kQuarter, moved(tilted, 0.1 * p), 0.1);  // pushed out along p
 }
 
 // Two linked unit rings, each through the other's centre: every point of one is exactly
@@ -210,9 +226,11 @@ TEST(ArcDistance, RandomSegmentArcPairsMatchBruteForce) {
     Segment s = random_segment(rng, scale);
     if (i % 4 == 0) {  // through the bend's inside, near the centre
       const Vec3 p = a.centre + 0.5 * a.radius * brute_force::random_unit_vector(rng);
-      s = {p - a.radius * brute_force::random_unit_vector(rng), p + a.radius * brute_force::random_unit_vector(rng)};
+      s = {p - a.radius * brute_force::random_unit_vector(rng),
+           p + a.radius * brute_force::random_unit_vector(rng)};
     }
-    failures += i % 2 ? compare_with_brute_force(s, a, scale, i) : compare_with_brute_force(a, s, scale, i);
+    failures +=
+        i % 2 ? compare_with_brute_force(s, a, scale, i) : compare_with_brute_force(a, s, scale, i);
   }
 }
 
@@ -223,8 +241,12 @@ TEST(ArcDistance, RandomArcArcPairsMatchBruteForce) {
     const double scale = std::pow(10.0, brute_force::uniform(rng, -6.0, 6.0));
     const Arc a = random_arc(rng, scale);
     Arc b = random_arc(rng, scale);
-    if (i % 4 == 0) b.centre = a.centre + 0.3 * scale * brute_force::random_unit_vector(rng);  // close, often linked
-    if (i % 8 == 1) b = moved(rotated_in_plane(a, brute_force::uniform(rng, -1, 1)), 0.05 * scale * a.axis());  // nearly coaxial
+    if (i % 4 == 0)
+      b.centre =
+          a.centre + 0.3 * scale * brute_force::random_unit_vector(rng);  // close, often linked
+    if (i % 8 == 1)
+      b = moved(rotated_in_plane(a, brute_force::uniform(rng, -1, 1)),
+                0.05 * scale * a.axis());  // nearly coaxial
     failures += compare_with_brute_force(a, b, scale, i);
   }
 }

@@ -20,7 +20,8 @@ Segment scaled(const Segment& s, double k) { return {k * s.p0, k * s.p1}; }
 
 // The result is self-consistent: parameters in [0, 1], points on their segments, and the
 // distance is the points' separation.
-void expect_consistent(const Segment& a, const Segment& b, const sc::PieceClosestPoints& c, double scale) {
+void expect_consistent(const Segment& a, const Segment& b, const sc::PieceClosestPoints& c,
+                       double scale) {
   EXPECT_GE(c.parameter_a, 0.0);
   EXPECT_LE(c.parameter_a, 1.0);
   EXPECT_GE(c.parameter_b, 0.0);
@@ -85,11 +86,13 @@ TEST(SegmentDistance, Crossing) {
 }
 
 TEST(SegmentDistance, TJunction) {
-  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 0), Vec3(0.5, 1, 0)}, 0.0, 8.0, 0.5, 0.0);
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 0), Vec3(0.5, 1, 0)}, 0.0, 8.0, 0.5,
+              0.0);
 }
 
 TEST(SegmentDistance, SkewPerpendicular) {
-  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, -1, 2), Vec3(0.5, 1, 2)}, 2.0, 8.0, 0.5, 0.5);
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, -1, 2), Vec3(0.5, 1, 2)}, 2.0, 8.0, 0.5,
+              0.5);
 }
 
 TEST(SegmentDistance, SkewWithClampedInteriorSolution) {
@@ -99,12 +102,14 @@ TEST(SegmentDistance, SkewWithClampedInteriorSolution) {
 }
 
 TEST(SegmentDistance, ZeroLengthFirst) {
-  expect_case({Vec3(0.5, 2, 0), Vec3(0.5, 2, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 2.0, 8.0, 0.0, 0.5);
+  expect_case({Vec3(0.5, 2, 0), Vec3(0.5, 2, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 2.0, 8.0, 0.0,
+              0.5);
   expect_case({Vec3(-3, 4, 0), Vec3(-3, 4, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 5.0, 8.0, 0.0, 0.0);
 }
 
 TEST(SegmentDistance, ZeroLengthSecond) {
-  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 2), Vec3(0.5, 0, 2)}, 2.0, 8.0, 0.5, 0.0);
+  expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 2), Vec3(0.5, 0, 2)}, 2.0, 8.0, 0.5,
+              0.0);
 }
 
 TEST(SegmentDistance, ZeroLengthBoth) {
@@ -113,12 +118,19 @@ TEST(SegmentDistance, ZeroLengthBoth) {
 }
 
 TEST(SegmentDistance, ZeroLengthOnSegment) {
-  expect_case({Vec3(0.25, 0, 0), Vec3(0.25, 0, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 0.0, 8.0, 0.0, 0.25);
+  expect_case({Vec3(0.25, 0, 0), Vec3(0.25, 0, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 0.0, 8.0, 0.0,
+              0.25);
 }
 
 TEST(SegmentDistance, AlmostZeroLength) {
   // A segment 1e-13 long behaves as the point it nearly is.
   expect_case({Vec3(0.5, 2, 0), Vec3(0.5 + 1e-13, 2, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 2.0);
+  // One whose squared length underflows is taken as a point (no 1 / 0 anywhere).
+  const Segment tiny{Vec3(0.5, 2, 0), Vec3(0.5, 2, 1e-160)};
+  const sc::PieceClosestPoints c = sc::closest_points(tiny, {Vec3(0, 0, 0), Vec3(1, 0, 0)});
+  EXPECT_EQ(c.distance, 2.0);
+  EXPECT_EQ(c.parameter_b, 0.5);
+  EXPECT_EQ(sc::closest_points(Segment{Vec3(0, 0, 0), Vec3(1, 0, 0)}, tiny).distance, 2.0);
 }
 
 // Lines in the planes z = 0 and z = h crossing (in projection) at the origin at angle theta:
@@ -129,7 +141,8 @@ TEST(SegmentDistance, NearlyParallelCrossingInProjection) {
     for (const double h : {0.0, 1e-9, 1e-3, 0.5}) {
       SCOPED_TRACE(testing::Message() << "theta " << theta << " h " << h);
       const Vec3 d(std::cos(theta), std::sin(theta), 0.0);
-      expect_case({Vec3(-1, 0, 0), Vec3(1, 0, 0)}, {Vec3(0, 0, h) - 0.7 * d, Vec3(0, 0, h) + 1.3 * d}, h);
+      expect_case({Vec3(-1, 0, 0), Vec3(1, 0, 0)},
+                  {Vec3(0, 0, h) - 0.7 * d, Vec3(0, 0, h) + 1.3 * d}, h);
     }
   }
 }
@@ -141,8 +154,8 @@ TEST(SegmentDistance, NearlyParallelOverlapping) {
     SCOPED_TRACE(testing::Message() << "theta " << theta);
     // Below theta ~ 1e-7 every point of the overlap ties within rounding: no parameter check.
     const bool distinct = theta > 1e-7;
-    expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 0.25), Vec3(1.5, theta, 0.25)}, 0.25, 8.0,
-                distinct ? 0.5 : -1.0, distinct ? 0.0 : -1.0);
+    expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.5, 0, 0.25), Vec3(1.5, theta, 0.25)}, 0.25,
+                8.0, distinct ? 0.5 : -1.0, distinct ? 0.0 : -1.0);
     // Drifting towards a instead, within a's span: the minimum is at b's second end.
     expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(0.2, 0, 0.25), Vec3(0.8, 0, 0.25 - theta)},
                 0.25 - theta, 8.0, 0.8, 1.0);
@@ -151,12 +164,14 @@ TEST(SegmentDistance, NearlyParallelOverlapping) {
 
 TEST(SegmentDistance, NearlyParallelEndToEnd) {
   for (const double theta : {1e-6, 1e-12}) {
-    expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(1.5, 0, 0), Vec3(2.5, theta, 0)}, 0.5, 8.0, 1.0, 0.0);
+    expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(1.5, 0, 0), Vec3(2.5, theta, 0)}, 0.5, 8.0,
+                1.0, 0.0);
   }
 }
 
 TEST(SegmentDistance, VeryDifferentLengths) {
-  expect_case({Vec3(0, 0, 0), Vec3(1e6, 0, 0)}, {Vec3(3, 1, 0.5), Vec3(3, 1, 0.5 + 1e-6)}, std::hypot(1.0, 0.5),
+  expect_case({Vec3(0, 0, 0), Vec3(1e6, 0, 0)}, {Vec3(3, 1, 0.5), Vec3(3, 1, 0.5 + 1e-6)},
+              std::hypot(1.0, 0.5),
               1e7);  // rounding relative to a's length 1e6
 }
 
@@ -168,30 +183,36 @@ TEST(SegmentDistance, RandomPairsMatchBruteForce) {
   int failures = 0;
   for (int i = 0; i < n; ++i) {
     const double scale = std::pow(10.0, brute_force::uniform(rng, -6.0, 6.0));
-    const Vec3 origin = scale * Vec3(brute_force::uniform(rng, -3, 3), brute_force::uniform(rng, -3, 3),
-                                     brute_force::uniform(rng, -3, 3));
-    const Segment a{origin, origin + scale * brute_force::uniform(rng, 0, 2) * brute_force::random_unit_vector(rng)};
+    const Vec3 origin =
+        scale * Vec3(brute_force::uniform(rng, -3, 3), brute_force::uniform(rng, -3, 3),
+                     brute_force::uniform(rng, -3, 3));
+    const Segment a{origin, origin + scale * brute_force::uniform(rng, 0, 2) *
+                                         brute_force::random_unit_vector(rng)};
     Segment b;
     if (i % 3 == 0) {  // nearly parallel to a, tilted by up to 1e-3 .. 1e-12 rad
       const Vec3 dir = (a.p1 - a.p0).normalized();
       const Vec3 tilt = brute_force::random_unit_vector(rng).cross(dir) *
                         std::pow(10.0, brute_force::uniform(rng, -12, -3));
-      const Vec3 start = a.point(brute_force::uniform(rng, -0.5, 1.5)) +
-                         scale * brute_force::uniform(rng, 0, 0.3) * brute_force::random_unit_vector(rng);
+      const Vec3 start =
+          a.point(brute_force::uniform(rng, -0.5, 1.5)) +
+          scale * brute_force::uniform(rng, 0, 0.3) * brute_force::random_unit_vector(rng);
       b = {start, start + scale * brute_force::uniform(rng, 0.1, 2) * (dir + tilt)};
     } else {
-      const Vec3 start = origin + scale * Vec3(brute_force::uniform(rng, -1, 1), brute_force::uniform(rng, -1, 1),
-                                               brute_force::uniform(rng, -1, 1));
-      b = {start, start + scale * brute_force::uniform(rng, 0, 2) * brute_force::random_unit_vector(rng)};
+      const Vec3 start =
+          origin + scale * Vec3(brute_force::uniform(rng, -1, 1), brute_force::uniform(rng, -1, 1),
+                                brute_force::uniform(rng, -1, 1));
+      b = {start,
+           start + scale * brute_force::uniform(rng, 0, 2) * brute_force::random_unit_vector(rng)};
     }
     const sc::PieceClosestPoints c = sc::closest_points(a, b);
     const brute_force::Result ref =
         brute_force::curve_distance(brute_force::as_curve(a), brute_force::as_curve(b));
     const double tol = 1e-9 * scale;
-    const bool ok = c.distance <= ref.distance + 16 * kEps * scale && c.distance >= ref.distance - tol;
+    const bool ok =
+        c.distance <= ref.distance + 16 * kEps * scale && c.distance >= ref.distance - tol;
     if (!ok) {
-      ADD_FAILURE() << "pair " << i << " scale " << scale << ": exact " << c.distance << " brute force "
-                    << ref.distance;
+      ADD_FAILURE() << "pair " << i << " scale " << scale << ": exact " << c.distance
+                    << " brute force " << ref.distance;
       if (++failures > 5) break;
     }
     expect_consistent(a, b, c, 3 * scale);
@@ -202,7 +223,8 @@ TEST(SegmentDistance, RandomPairsMatchBruteForce) {
 TEST(SegmentDistance, ArgumentOrderMirrorsExactly) {
   brute_force::Rng rng(7);
   for (int i = 0; i < 1000; ++i) {
-    const Segment a{brute_force::random_unit_vector(rng), 2.0 * brute_force::random_unit_vector(rng)};
+    const Segment a{brute_force::random_unit_vector(rng),
+                    2.0 * brute_force::random_unit_vector(rng)};
     const Segment b{brute_force::random_unit_vector(rng), -brute_force::random_unit_vector(rng)};
     const sc::PieceClosestPoints ab = sc::closest_points(a, b), ba = sc::closest_points(b, a);
     EXPECT_EQ(ab.distance, ba.distance);

@@ -18,13 +18,19 @@ inline void require_finite(double value, std::string_view field) {
   if (!std::isfinite(value)) fail_argument(field, "must be finite, got " + std::to_string(value));
 }
 
+// Names the first offending entry only: a 6N force vector must not flood the message.
 template <typename Derived>
 void require_finite(const Eigen::DenseBase<Derived>& value, std::string_view field) {
-  if (!value.allFinite()) {
-    std::ostringstream os;
-    os << "must be finite, got [" << value.transpose() << "]";
-    fail_argument(field, os.str());
-  }
+  if (value.allFinite()) return;
+  for (Eigen::Index j = 0; j < value.cols(); ++j)
+    for (Eigen::Index i = 0; i < value.rows(); ++i)
+      if (!std::isfinite(value(i, j))) {
+        std::ostringstream os;
+        os << "must be finite, got " << value(i, j) << " at entry ";
+        if (value.cols() == 1) os << i; else os << "(" << i << ", " << j << ")";
+        os << " of " << value.size();
+        fail_argument(field, os.str());
+      }
 }
 
 inline void require_positive(double value, std::string_view field) {

@@ -29,8 +29,15 @@ inline void require_unit(const Quat& q, std::string_view field) {
                              std::to_string(norm));
 }
 
+inline bool is_valid(const Pose& pose) {
+  return pose.x.allFinite() && pose.q.coeffs().allFinite() &&
+         std::abs(pose.q.norm() - 1.0) <= kUnitQuaternionTolerance;
+}
+
 // Throws std::invalid_argument naming "pose.x" or "pose.q" when the pose is unusable.
+// The names are built only on failure: validation sits on every distance query.
 inline void validate(const Pose& pose, std::string_view name = "pose") {
+  if (is_valid(pose)) return;
   const std::string prefix(name);
   require_finite(pose.x, prefix + ".x");
   require_unit(pose.q, prefix + ".q");

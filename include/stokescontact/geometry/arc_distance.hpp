@@ -23,7 +23,8 @@
 // closest points on C are seeded as candidates up front (closed form), so only the circle
 // term needs bounding, and only where the polar angle can reach the range. The distance
 // to a circle has Hessian >= -1/rho (rho: distance from the circle's axis), so along C it
-// is semiconvex with modulus R + R^2 / rho_min.
+// is semiconvex with modulus R + R^2 / rho_min; from a point outside the circle's cylinder
+// the circle lies behind a plane, as a convex target would.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -100,10 +101,23 @@ inline double semiconvex_bound(double gl, double dl, double gr, double dr, doubl
 //            >= f(a) + f'(a) h - (max(n . radial, 0) + |f'(a)| w / 3) h^2 / 2
 // by 1 - cos h <= h^2 / 2 and |sin h - h| <= |h|^3 / 6. The modulus is 0 for a target
 // outside the bend and never needs to exceed R (f + R t^2 / 2 is convex anyway).
+// Each end's own modulus also gives a bound alone (its parabola is lowest at an end of
+// the interval); at a polished minimum (slope 0) facing a target outside the bend that
+// alone certifies the whole interval, however steep f is at the other end.
+inline double modulus(const Reach& e, double w, double radius) {
+  return std::min(e.bend + std::abs(e.slope) * w / 3.0, radius);
+}
+
+inline double one_end_bound(const Reach& e, double signed_w, double radius) {
+  const double w = std::abs(signed_w);
+  return std::min(e.distance,
+                  e.distance + e.slope * signed_w - 0.5 * modulus(e, w, radius) * w * w);
+}
+
 inline double convex_bound(const Reach& l, const Reach& r, double w, double radius) {
-  const double slope = std::max(std::abs(l.slope), std::abs(r.slope));
-  const double bend = std::max(l.bend, r.bend) + slope * w / 3.0;
-  return semiconvex_bound(l.distance, l.slope, r.distance, r.slope, w, std::min(bend, radius));
+  const double m = std::max(modulus(l, w, radius), modulus(r, w, radius));
+  return std::max({semiconvex_bound(l.distance, l.slope, r.distance, r.slope, w, m),
+                   one_end_bound(l, w, radius), one_end_bound(r, -w, radius)});
 }
 
 // Along C(t), the squared distance to a fixed point o and the height of C(t) - o along a
@@ -161,9 +175,9 @@ inline Range squared(const Range& r) {
   return {r.lo <= 0.0 && r.hi >= 0.0 ? 0.0 : std::min(a, b), std::max(a, b)};
 }
 
-// Target: a segment of nonzero length (convex). Its distance is the distance to its line
-// plus, past an end, the overshoot along it: both bounded through the probe (o = p0,
-// u along the segment).
+// Target: a segment (not a point, see is_point), a convex set. Its distance is the
+// distance to its line plus, past an end, the overshoot along it: both bounded through the
+// probe (o = p0, u along the segment).
 class SegmentTarget {
  public:
   struct Sample : ArcSample {
@@ -216,10 +230,9 @@ class SegmentTarget {
 class ArcTarget {
  public:
   struct Sample : ArcSample {
-    double circle;  // distance to the full circle
-    double circle_slope;
-    double rho;  // distance from the circle's axis
-    double gap;  // polar angle's distance from [0, angle], 0 inside
+    Reach circle;  // distance to the full circle
+    double rho;    // distance from the circle's axis
+    double gap;    // polar angle's distance from [0, angle], 0 inside
     Probe probe;
   };
 
@@ -236,7 +249,7 @@ class ArcTarget {
     for (int k = 0; k < 2; ++k) {
       const CurvePoint c = closest_point(along_, ends_[k]);
       static_cast<ArcSample&>(out[k]) = {c.parameter, c.distance, 0.0, k == 0 ? 0.0 : arc_.angle,
-                                         c.point, ends_[k]};
+                                         c.point,     ends_[k]};
     }
     return out;
   }
@@ -253,13 +266,12 @@ class ArcTarget {
     s.gap = 0.0;
     if (s.rho > 0.0) {
       const Vec3 radial = (px * arc_.e1 + py * arc_.e2) / s.rho;
-      const Reach c = reach(x - arc_.radius * radial, m);
-      s.circle = c.distance, s.circle_slope = c.slope;
+      s.circle = reach(x - arc_.radius * radial, m);
       double phi = std::atan2(py, px);
       if (phi < 0.0) phi += 2.0 * std::numbers::pi;
       if (phi > arc_.angle) s.gap = std::min(phi - arc_.angle, 2.0 * std::numbers::pi - phi);
       if (s.gap == 0.0) {
-        s.f = s.circle, s.df = s.circle_slope, s.u = phi;
+        s.f = s.circle.distance, s.df = s.circle.slope, s.u = phi;
         s.target_point = arc_.centre + arc_.radius * radial;
         return s;
       }
@@ -267,7 +279,7 @@ class ArcTarget {
     const Reach e0 = reach(m.point - ends_[0], m), e1 = reach(m.point - ends_[1], m);
     const bool second = e1.distance < e0.distance;  // the nearer end
     const Reach& e = second ? e1 : e0;
-    if (!(s.rho > 0.0)) s.circle = e.distance, s.circle_slope = e.slope;  // on the axis
+    if (!(s.rho > 0.0)) s.circle = {e.distance, e.slope, 0.0};  // on the axis
     s.f = e.distance, s.df = e.slope;
     s.u = second ? arc_.angle : 0.0;
     s.target_point = ends_[second ? 1 : 0];
@@ -287,11 +299,16 @@ class ArcTarget {
     if (rho_min > 0.0 && std::max(l.gap, r.gap) * rho_min > radius * w)
       return std::numeric_limits<double>::infinity();
     const double off_circle = std::max({rho_lo - arc_.radius, arc_.radius - rho_hi, 0.0});
-    double circle = std::max(lipschitz_bound(l.circle, r.circle, w, radius),
+    double circle = std::max(lipschitz_bound(l.circle.distance, r.circle.distance, w, radius),
                              std::sqrt(off_circle * off_circle + z2.lo));
     if (rho_min > 0.0)
-      circle = std::max(circle, semiconvex_bound(l.circle, l.circle_slope, r.circle, r.circle_slope,
-                                                 w, radius + radius * radius / rho_min));
+      circle =
+          std::max(circle, semiconvex_bound(l.circle.distance, l.circle.slope, r.circle.distance,
+                                            r.circle.slope, w, radius + radius * radius / rho_min));
+    // From a sample outside the circle's cylinder (rho >= radius) the whole circle lies
+    // behind the plane through its closest point normal to n: a convex target's bound.
+    if (l.rho >= arc_.radius) circle = std::max(circle, one_end_bound(l.circle, w, radius));
+    if (r.rho >= arc_.radius) circle = std::max(circle, one_end_bound(r.circle, -w, radius));
     return std::max({0.0, lipschitz_bound(l.f, r.f, w, radius), circle});
   }
 
@@ -302,12 +319,12 @@ class ArcTarget {
   Arc along_;
 };
 
-// Search tuning: initial grid spacing (a quarter arc starts with 4 intervals), the
+// Search tuning: initial grid spacing (a quarter arc starts with 2 intervals), the
 // tolerance tau relative to the arc radius plus the best distance, and the budgets. The
 // budget binds only where f stays within tau of its minimum along a stretch in a way no
 // bound above sees (two linked rings, each through the other's centre, are 1 apart at
 // every point): the best sample is then as good as any.
-inline constexpr double kArcGridStep = std::numbers::pi / 8.0;
+inline constexpr double kArcGridStep = std::numbers::pi / 4.0;
 inline constexpr double kArcTolerance = 1e-12;
 inline constexpr int kArcMaxSamples = 160;
 inline constexpr int kArcMaxEvaluations = 400;
@@ -353,31 +370,36 @@ PieceClosestPoints minimise_along_arc(const Arc& arc, const Target& target, doub
   // falsi on g' = f f' = (C - y) . C', the slope of f^2 / 2, which stays smooth through a
   // crossing (f = 0) where f' jumps. It converges superlinearly and keeps the bracket; its
   // sign can only turn from - to + at a local minimum (f's kinks at the medial axis of an
-  // arc target are concave). Returns the best sample seen.
+  // arc target are concave).
   const auto polish = [&](const Sample& l, const Sample& r) {
-    double a = l.t, b = r.t, ga = l.f * l.df, gb = r.f * r.df;
-    Sample best_seen = l.f <= r.f ? l : r;
+    constexpr double eps = std::numeric_limits<double>::epsilon();
+    Sample lo = l, hi = r;
+    double ga = l.f * l.df, gb = r.f * r.df;  // Illinois scales these down
     int side = 0;
     for (int step = 0; step < kArcMaxPolishSteps && evaluations < kArcMaxEvaluations; ++step) {
-      if (b - a <= 4.0 * std::numeric_limits<double>::epsilon() * (1.0 + a + b)) break;
+      const double a = lo.t, b = hi.t;
+      if (b - a <= 4.0 * eps * (1.0 + a + b)) break;
       double x = a + (b - a) * (-ga / (gb - ga));
       if (!(x > a && x < b)) x = 0.5 * (a + b);
       const Sample s = evaluate(x);
-      if (s.f < best_seen.f) best_seen = s;
       const double g = s.f * s.df;
+      // Within its own rounding, g' has found its root.
+      const double noise = 8.0 * eps * arc.radius *
+                           (s.point.cwiseAbs().maxCoeff() + s.target_point.cwiseAbs().maxCoeff());
+      if (std::abs(g) <= noise) return s;
       if (g > 0.0) {
-        b = x, gb = g;
+        hi = s, gb = g;
         if (side == 1) ga *= 0.5;
         side = 1;
-      } else if (g < 0.0) {
-        a = x, ga = g;
+      } else {
+        lo = s, ga = g;
         if (side == -1) gb *= 0.5;
         side = -1;
-      } else {
-        break;
       }
     }
-    return best_seen;
+    // The bracket end nearer the root. (Not the lower f: f is flat here, and picking by its
+    // rounding noise would scatter the witness along t.)
+    return std::abs(lo.f * lo.df) <= std::abs(hi.f * hi.df) ? lo : hi;
   };
 
   const int n = std::clamp(static_cast<int>(std::ceil(arc.angle / kArcGridStep)), 1, 32);
@@ -411,7 +433,7 @@ PieceClosestPoints minimise_along_arc(const Arc& arc, const Target& target, doub
 // distance >= cutoff is promised (this lets a caller skip pieces that cannot win).
 inline PieceClosestPoints closest_points(const Segment& s, const Arc& a,
                                          double cutoff = std::numeric_limits<double>::infinity()) {
-  if (s.p0 == s.p1) {  // a point: the arc's closest point is exact in closed form
+  if (is_point(s)) {  // a point: the arc's closest point is exact in closed form
     const CurvePoint c = closest_point(a, s.p0);
     return {0.0, c.parameter, s.p0, c.point, c.distance};
   }
@@ -427,7 +449,8 @@ inline PieceClosestPoints closest_points(const Arc& a, const Segment& s,
 // a), whose curvature enters the bounds' modulus.
 inline PieceClosestPoints closest_points(const Arc& a, const Arc& b,
                                          double cutoff = std::numeric_limits<double>::infinity()) {
-  if (b.radius < a.radius) return swapped(detail::minimise_along_arc(b, detail::ArcTarget(a, b), cutoff));
+  if (b.radius < a.radius)
+    return swapped(detail::minimise_along_arc(b, detail::ArcTarget(a, b), cutoff));
   return detail::minimise_along_arc(a, detail::ArcTarget(b, a), cutoff);
 }
 

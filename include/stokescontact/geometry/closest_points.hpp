@@ -14,10 +14,10 @@
 namespace stokescontact {
 
 struct ClosestPoints {
-  double distance = 0.0;         // signed: centre-curve distance minus both radii (< 0: overlap)
-  Vec3 point_a = Vec3::Zero();   // world surface points realising it
+  double distance = 0.0;        // signed: centre-curve distance minus both radii (< 0: overlap)
+  Vec3 point_a = Vec3::Zero();  // world surface points realising it
   Vec3 point_b = Vec3::Zero();
-  Vec3 normal = Vec3::UnitX();   // unit, from a towards b: point_b - point_a = distance * normal
+  Vec3 normal = Vec3::UnitX();  // unit, from a towards b: point_b - point_a = distance * normal
   Vec3 curve_point_a = Vec3::Zero();  // the centre-curve points under them
   Vec3 curve_point_b = Vec3::Zero();
 };
@@ -151,6 +151,18 @@ inline ClosestPoints finish(const CurveContact& c, double radius_a, double radiu
   return out;
 }
 
+// A shape's centre curve in the world frame; a sphere's is its centre, nothing to rotate.
+template <Shape S>
+auto world_curve(const S& shape, const Pose& pose) {
+  return to_world(centre_curve(shape), pose);
+}
+
+inline CentreCurve<1, 0> world_curve(const Sphere&, const Pose& pose) {
+  CentreCurve<1, 0> c;
+  c.segments[0] = {pose.x, pose.x};
+  return c;
+}
+
 // A reference centre for a bare curve: the mean of its pieces' end points.
 template <std::size_t NS, std::size_t NA>
 Vec3 reference_centre(const CentreCurve<NS, NA>& c) {
@@ -186,7 +198,7 @@ ClosestPoints closest_points(const A& a, const Pose& pose_a, const B& b, const P
   if constexpr (std::is_same_v<A, Sphere> && std::is_same_v<B, Sphere>) {
     c.points = {0.0, 0.0, pose_a.x, pose_b.x, (pose_b.x - pose_a.x).norm()};
   } else {
-    c = detail::curve_contact(to_world(centre_curve(a), pose_a), to_world(centre_curve(b), pose_b));
+    c = detail::curve_contact(detail::world_curve(a, pose_a), detail::world_curve(b, pose_b));
   }
   return detail::finish(c, a.radius, b.radius, pose_a.x, pose_b.x);
 }

@@ -22,6 +22,12 @@ inline PieceClosestPoints swapped(const PieceClosestPoints& c) {
   return {c.parameter_b, c.parameter_a, c.point_b, c.point_a, c.distance};
 }
 
+// A segment whose squared length underflows the normal doubles acts as the point p0 (its
+// inverse squared length would overflow).
+inline bool is_point(const Segment& s) {
+  return !((s.p1 - s.p0).squaredNorm() >= std::numeric_limits<double>::min());
+}
+
 namespace detail {
 
 // a is the shorter segment, b the longer one, neither of zero length.
@@ -68,14 +74,14 @@ inline PieceClosestPoints closest_points_ordered(const Segment& a, const Segment
 // The shorter segment is always measured against the longer one, so (a, b) and (b, a)
 // run the same arithmetic and give mirrored results exactly (unless the lengths tie).
 inline PieceClosestPoints closest_points(const Segment& a, const Segment& b) {
-  const double la = (a.p1 - a.p0).squaredNorm(), lb = (b.p1 - b.p0).squaredNorm();
-  if (la == 0.0 || lb == 0.0) {  // a point against a segment (or a point)
-    const bool point_a = la == 0.0;
+  if (is_point(a) || is_point(b)) {  // a point against a segment (or a point)
+    const bool point_a = is_point(a);
     const CurvePoint c = closest_point(point_a ? b : a, point_a ? a.p0 : b.p0);
     return point_a ? PieceClosestPoints{0.0, c.parameter, a.p0, c.point, c.distance}
                    : PieceClosestPoints{c.parameter, 0.0, c.point, b.p0, c.distance};
   }
-  if (la > lb) return swapped(detail::closest_points_ordered(b, a));
+  if ((a.p1 - a.p0).squaredNorm() > (b.p1 - b.p0).squaredNorm())
+    return swapped(detail::closest_points_ordered(b, a));
   return detail::closest_points_ordered(a, b);
 }
 

@@ -15,8 +15,9 @@
 //
 // Method. Jeffrey & Onishi expand each sphere's disturbance in Lamb's solution (coefficients
 // P, V, Q of the pressure, potential and rotlet harmonics of degree n) and reflect it off the
-// other sphere; the coefficient of a1^p a2^q / r^(p+q) obeys a recurrence (their eq. 3.9-3.11
-// for X^A, 4.6-4.11 for Y^A, Y^B, Y^C; as corrected by Townsend, arXiv:1802.08226). For
+// other sphere; the coefficient of a1^p a2^q / r^(p+q) obeys a recurrence (their Sec. 3 for
+// X^A, eq. 4.6-4.11 for Y^A and Y^B, 7.3-7.5 for Y^C; as corrected by Townsend,
+// arXiv:1802.08226). For
 // equal spheres only the total order k = p + q matters, which collapses the recurrence to
 // P_n(k), and odd k belongs to the other sphere. The recurrences are for the resistance
 // problem (velocities given); for the mobility problem the degree-1 force and torque
