@@ -9,12 +9,15 @@
 #include <vector>
 
 #include "stokescontact/contact/barrier.hpp"
+#include "common/test_support.hpp"
 
 namespace sc = stokescontact;
 using sc::BarrierFunction;
 using sc::BarrierParameters;
 
 namespace {
+
+using test_support::expect_rejects;
 
 constexpr std::array<BarrierFunction, 3> kAll = {BarrierFunction::b, BarrierFunction::b0, BarrierFunction::b1};
 
@@ -31,16 +34,6 @@ const char* name(BarrierFunction f) {
 // non-unit scale.
 std::vector<BarrierParameters> parameter_sets() {
   return {{1.0, 0.0, 1e-2}, {0.05, 0.05, 1e-3}, {3.0, 0.5, 0.2}};
-}
-
-template <typename F>
-void expect_rejects(F&& f, const std::string& field) {
-  try {
-    f();
-    FAIL() << "expected std::invalid_argument naming " << field;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-  }
 }
 
 }  // namespace

@@ -340,8 +340,9 @@ TEST_P(LcpSolverTest, NonConvergenceIsReportedWithItsResidual) {
   EXPECT_EQ(r.iterations, 1);
 }
 
-// PSD A with no solution: A = [1 -1; -1 1], b = (-1, -1) gives w_1 + w_2 = -2 for every gamma.
-// And A = 0 with b_0 < 0. Every solver stops within its budget and says it did not converge.
+// PSD A with no solution: A = [1 -1; -1 1], b = (-1, -1) gives w_1 + w_2 = -2 for every gamma;
+// A = 0 with b_0 < 0; A = diag(1, 0) with b_2 < 0. Every solver stops within its budget and
+// says it did not converge.
 TEST_P(LcpSolverTest, InfeasibleProblemIsReportedUnconverged) {
   sc::MatX A(2, 2);
   A << 1.0, -1.0, -1.0, 1.0;
@@ -353,6 +354,12 @@ TEST_P(LcpSolverTest, InfeasibleProblemIsReportedUnconverged) {
   const sc::LcpResult zero = solve(sc::MatX::Zero(3, 3), (sc::VecX(3) << -1.0, 2.0, 0.0).finished(), options);
   EXPECT_FALSE(zero.converged);
   EXPECT_DOUBLE_EQ(zero.residual, 0.5);
+  // p0 = (0, -1) lies in the null space of A = diag(1, 0): the first step size comes from the
+  // power-iteration fallback; w_2 = -1 whatever gamma is.
+  const sc::MatX singular = (sc::VecX(2) << 1.0, 0.0).finished().asDiagonal();
+  const sc::LcpResult null_start = solve(singular, (sc::VecX(2) << 1.0, -1.0).finished(), options);
+  EXPECT_FALSE(null_start.converged);
+  EXPECT_GE(null_start.residual, 1.0 - 1e-12);
 }
 
 TEST_P(LcpSolverTest, EmptyAndZeroProblemsAreSolvedForFree) {

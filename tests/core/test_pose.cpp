@@ -6,21 +6,13 @@
 #include <string>
 
 #include "stokescontact/core/pose.hpp"
+#include "common/test_support.hpp"
 
 namespace sc = stokescontact;
 
 namespace {
 
-// Runs f, expects std::invalid_argument whose message names `field`.
-template <typename F>
-void expect_rejects(F&& f, const std::string& field) {
-  try {
-    f();
-    FAIL() << "expected std::invalid_argument naming " << field;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-  }
-}
+using test_support::expect_rejects;
 
 }  // namespace
 

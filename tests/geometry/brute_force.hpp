@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "stokescontact/geometry/centre_curve.hpp"
+#include "common/test_support.hpp"
 
 namespace brute_force {
 
@@ -108,26 +109,9 @@ inline sc::CentreCurve<0, 1> as_curve(const sc::Arc& a) {
 
 // Random inputs shared by the distance tests (fixed seeds in each test).
 using Rng = std::mt19937_64;
-
-inline double uniform(Rng& rng, double lo, double hi) {
-  return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
-
-inline sc::Vec3 random_unit_vector(Rng& rng) {
-  for (;;) {
-    const sc::Vec3 v(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    const double n = v.norm();
-    if (n > 0.1 && n < 1.0) return v / n;
-  }
-}
-
-inline sc::Quat random_rotation(Rng& rng) {
-  for (;;) {
-    const Eigen::Vector4d v(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
-                            uniform(rng, -1, 1));
-    if (v.norm() > 0.1 && v.norm() < 1.0) return sc::Quat(v[0], v[1], v[2], v[3]).normalized();
-  }
-}
+using test_support::random_rotation;
+using test_support::random_unit_vector;
+using test_support::uniform;
 
 // Sanitizer builds (GCC and Clang define __SANITIZE_ADDRESS__ under -fsanitize=address) run
 // an order of magnitude slower: they check a tenth of the random pairs.

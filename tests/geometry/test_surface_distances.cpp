@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "stokescontact/geometry/surface_distances.hpp"
+#include "common/test_support.hpp"
 
 namespace sc = stokescontact;
 using sc::PairSource;
@@ -22,17 +23,8 @@ namespace {
 // Tolerance on d^S >= d^P and on the d^P pair, relative to the bodies' size.
 constexpr double kTol = 1e-10;
 
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
-
-sc::Quat random_rotation(std::mt19937_64& rng) {
-  for (;;) {
-    const Eigen::Vector4d v(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
-                            uniform(rng, -1, 1));
-    if (v.norm() > 0.1 && v.norm() < 1.0) return sc::Quat(v[0], v[1], v[2], v[3]).normalized();
-  }
-}
+using test_support::random_rotation;
+using test_support::uniform;
 
 // Dense samples of a centre curve in the world frame, and the largest gap between
 // neighbouring samples along it: a sampled distance overestimates the true one by at most

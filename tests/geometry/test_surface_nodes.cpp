@@ -9,15 +9,14 @@
 #include <string>
 
 #include "stokescontact/geometry/surface_nodes.hpp"
+#include "common/test_support.hpp"
 
 namespace sc = stokescontact;
 using sc::Vec3;
 
 namespace {
 
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
+using test_support::uniform;
 
 // Nearest-neighbour distance of every node, by brute force.
 std::vector<double> nearest_neighbour(const sc::Mat3X& p) {

@@ -11,10 +11,13 @@
 #include "stokescontact/geometry/centre_curve.hpp"
 #include "stokescontact/mobility/blob_models.hpp"
 #include "stokescontact/mobility/single_body_mobility.hpp"
+#include "common/test_support.hpp"
 
 namespace sc = stokescontact;
 
 namespace {
+
+using test_support::expect_rejects;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -34,16 +37,6 @@ double min_distance(const sc::Mat3X& x) {
   for (Eigen::Index i = 0; i < x.cols(); ++i)
     for (Eigen::Index j = i + 1; j < x.cols(); ++j) best = std::min(best, (x.col(i) - x.col(j)).norm());
   return best;
-}
-
-template <typename F>
-void expect_invalid_argument_naming(F&& f, const std::string& field) {
-  try {
-    f();
-    ADD_FAILURE() << "no exception; expected one naming " << field;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-  }
 }
 
 // The x <-> z mirror of a boomerang's body frame, acting on (u, omega): velocities are
@@ -120,11 +113,11 @@ TEST(SphereShell, HydrodynamicRadiusRequestIsHonoured) {
 }
 
 TEST(SphereShell, RejectsBadInput) {
-  expect_invalid_argument_naming([] { sc::sphere_shell(13, 1.0); }, "blobs");
-  expect_invalid_argument_naming([] { sc::sphere_shell(2562, 1.0); }, "blobs");
-  expect_invalid_argument_naming([] { sc::sphere_shell(12, 0.0); }, "hydrodynamic_radius");
-  expect_invalid_argument_naming([] { sc::sphere_shell(12, std::nan("")); }, "hydrodynamic_radius");
-  expect_invalid_argument_naming([] { sc::sphere_shell_geometric(42, -1.0); }, "geometric_radius");
+  expect_rejects([] { sc::sphere_shell(13, 1.0); }, "blobs");
+  expect_rejects([] { sc::sphere_shell(2562, 1.0); }, "blobs");
+  expect_rejects([] { sc::sphere_shell(12, 0.0); }, "hydrodynamic_radius");
+  expect_rejects([] { sc::sphere_shell(12, std::nan("")); }, "hydrodynamic_radius");
+  expect_rejects([] { sc::sphere_shell_geometric(42, -1.0); }, "geometric_radius");
 }
 
 TEST(RodBlobs, BlobsLieOnTheSurfaceInInterlockingRings) {
@@ -191,11 +184,11 @@ TEST(RodBlobs, TendsToSlenderBodyTheoryAsTheAspectRatioGrows) {
 }
 
 TEST(RodBlobs, RejectsBadInput) {
-  expect_invalid_argument_naming([] { sc::rod_blob_model({1.0, 0.5}, {2, 0.0, 0.0}); }, "blobs_per_ring");
-  expect_invalid_argument_naming([] { sc::rod_blob_model({1.0, 0.5}, {8, -0.1, 0.0}); }, "ring_spacing");
-  expect_invalid_argument_naming([] { sc::rod_blob_model({1.0, 0.5}, {8, 0.0, -1.0}); }, "blob_radius");
-  expect_invalid_argument_naming([] { sc::rod_blob_model({-1.0, 0.5}); }, "Spherocylinder.length");
-  expect_invalid_argument_naming([] { sc::rod_blob_model({1.0, 0.0}); }, "Spherocylinder.radius");
+  expect_rejects([] { sc::rod_blob_model({1.0, 0.5}, {2, 0.0, 0.0}); }, "blobs_per_ring");
+  expect_rejects([] { sc::rod_blob_model({1.0, 0.5}, {8, -0.1, 0.0}); }, "ring_spacing");
+  expect_rejects([] { sc::rod_blob_model({1.0, 0.5}, {8, 0.0, -1.0}); }, "blob_radius");
+  expect_rejects([] { sc::rod_blob_model({-1.0, 0.5}); }, "Spherocylinder.length");
+  expect_rejects([] { sc::rod_blob_model({1.0, 0.0}); }, "Spherocylinder.radius");
 }
 
 TEST(BoomerangBlobs, CurveBlobsLieOnTheCentreCurveAtEqualSpacing) {
@@ -249,18 +242,18 @@ TEST(BoomerangBlobs, MobilitiesHaveTheMirrorSymmetryAndAgreeAcrossResolutions) {
 TEST(BlobModel, ValidationNamesTheField) {
   sc::BlobModel m = sc::sphere_shell(12, 1.0);
   m.blob_radius = -1.0;
-  expect_invalid_argument_naming([&] { sc::validate(m, "models[3]"); }, "models[3].blob_radius");
+  expect_rejects([&] { sc::validate(m, "models[3]"); }, "models[3].blob_radius");
   m = sc::sphere_shell(12, 1.0);
   m.positions(1, 4) = std::numeric_limits<double>::infinity();
-  expect_invalid_argument_naming([&] { sc::validate(m); }, "model.positions");
+  expect_rejects([&] { sc::validate(m); }, "model.positions");
   m = sc::sphere_shell(12, 1.0);
   m.positions.col(5) = m.positions.col(2);  // coincident blobs
-  expect_invalid_argument_naming([&] { sc::validate(m); }, "model.positions");
+  expect_rejects([&] { sc::validate(m); }, "model.positions");
   sc::BlobModel line{"line", sc::Mat3X::Zero(3, 5), 0.5};
   for (Eigen::Index k = 0; k < 5; ++k) line.positions(2, k) = static_cast<double>(k);
-  expect_invalid_argument_naming([&] { sc::validate(line); }, "model.positions");
-  expect_invalid_argument_naming([&] { sc::single_body_mobility(line, 1.0); }, "model.positions");
+  expect_rejects([&] { sc::validate(line); }, "model.positions");
+  expect_rejects([&] { sc::single_body_mobility(line, 1.0); }, "model.positions");
   sc::BlobModel two{"two", sc::Mat3X::Identity(3, 2), 0.5};
-  expect_invalid_argument_naming([&] { sc::validate(two); }, "model.positions");
-  expect_invalid_argument_naming([] { sc::single_body_mobility(sc::sphere_shell(12, 1.0), -1.0); }, "viscosity");
+  expect_rejects([&] { sc::validate(two); }, "model.positions");
+  expect_rejects([] { sc::single_body_mobility(sc::sphere_shell(12, 1.0), -1.0); }, "viscosity");
 }

@@ -12,10 +12,13 @@
 // (Yan uses the absolute 2-norm with eps = 1e-5.) H compares gamma with w as they stand, so for
 // A far from unit scale the gamma-part weighs like 1/|A|; callers who care rescale gamma.
 //
+// Costs common to all solvers: a cold start (gamma0 = 0) has w0 = b for free, so b >= 0 returns
+// gamma = 0 after 0 iterations and 0 applications, as do Nc = 0 and b = 0; a nonzero warm start
+// costs one application for w0 (and returns after 0 iterations if it already solves the LCP);
+// each solver then spends one application on a curvature estimate along p0 = min(gamma0, w0).
+//
 // Shared by the solvers: options and result, the counted and checked operator, the start
 // (validation, trivial problems, warm start), the curvature estimate for first steps.
-#include <algorithm>
-#include <cmath>
 #include <concepts>
 #include <cstddef>
 #include <limits>

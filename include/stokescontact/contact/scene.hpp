@@ -24,7 +24,7 @@ void validate_scene(std::span<const S> shapes, std::span<const Pose> poses) {
                                 std::to_string(shapes.size()) + " shapes for " +
                                 std::to_string(poses.size()) + " poses");
   for (const S& s : shapes) validate(s);
-  for (std::size_t k = 0; k < poses.size(); ++k) validate(poses[k], "poses[" + std::to_string(k) + "]");
+  validate(poses);
 }
 
 }  // namespace stokescontact

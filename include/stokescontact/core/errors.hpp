@@ -33,6 +33,14 @@ void require_finite(const Eigen::DenseBase<Derived>& value, std::string_view fie
       }
 }
 
+// A vector argument of a fixed size with finite entries (forces, velocities).
+template <typename Derived>
+void require_finite(const Eigen::DenseBase<Derived>& value, Eigen::Index size, std::string_view field) {
+  if (value.size() != size)
+    fail_argument(field, "has size " + std::to_string(value.size()) + ", expected " + std::to_string(size));
+  require_finite(value, field);
+}
+
 inline void require_positive(double value, std::string_view field) {
   require_finite(value, field);
   if (!(value > 0.0)) fail_argument(field, "must be > 0, got " + std::to_string(value));

@@ -1,6 +1,8 @@
 #pragma once
 // Rigid-body pose: centre x and unit quaternion q (Broms eq. 1), body <-> world maps.
 #include <cmath>
+#include <cstddef>
+#include <span>
 #include <string>
 
 #include "stokescontact/core/errors.hpp"
@@ -41,6 +43,19 @@ inline void validate(const Pose& pose, std::string_view name = "pose") {
   const std::string prefix(name);
   require_finite(pose.x, prefix + ".x");
   require_unit(pose.q, prefix + ".q");
+}
+
+// A configuration: each pose valid, names "poses[k].x" / "poses[k].q" for the first bad one.
+inline void validate(std::span<const Pose> poses, std::string_view name = "poses") {
+  for (std::size_t k = 0; k < poses.size(); ++k)
+    if (!is_valid(poses[k])) validate(poses[k], std::string(name) + "[" + std::to_string(k) + "]");
+}
+
+// The same, and exactly `count` poses.
+inline void validate(std::span<const Pose> poses, std::size_t count, std::string_view name = "poses") {
+  if (poses.size() != count)
+    fail_argument(name, "has " + std::to_string(poses.size()) + " poses, expected " + std::to_string(count));
+  validate(poses, name);
 }
 
 }  // namespace stokescontact

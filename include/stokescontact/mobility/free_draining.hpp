@@ -99,11 +99,7 @@ class FreeDrainingMobility {
   // New poses, same bodies. Validates everything before changing anything.
   void set_configuration(std::span<const Pose> poses) {
     const std::size_t n = shape_of_body_.size();
-    if (poses.size() != n)
-      fail_argument("poses", "has " + std::to_string(poses.size()) + " poses, expected " + std::to_string(n));
-    for (std::size_t i = 0; i < n; ++i)  // names are built only for a bad pose
-      if (!poses[i].x.allFinite() || !(std::abs(poses[i].q.norm() - 1.0) <= kUnitQuaternionTolerance))
-        validate(poses[i], "poses[" + std::to_string(i) + "]");
+    validate(poses, n);
     if (needs_rotations_) {
       std::vector<Mat3> rotations(n);
       for (std::size_t i = 0; i < n; ++i) rotations[i] = poses[i].rotation();
@@ -115,9 +111,7 @@ class FreeDrainingMobility {
   // U = M F, one application; F stacked per body (f_i[, tau_i]).
   VecX apply(const VecX& F) {
     require_configured();
-    if (F.size() != size())
-      fail_argument("F", "has size " + std::to_string(F.size()) + ", expected " + std::to_string(size()));
-    if (!F.allFinite()) fail_argument("F", "must be finite");
+    require_finite(F, size(), "F");
     counter_.count();
     VecX U(size());
     // Serial: a few flops per body, bound by memory bandwidth; threads would not pay.

@@ -92,9 +92,7 @@ class MultiblobMobility {
   // New poses, same bodies. Validates everything before changing anything.
   void set_configuration(std::span<const Pose> poses) {
     const std::size_t n = body_models_.size();
-    if (poses.size() != n)
-      fail_argument("poses", "has " + std::to_string(poses.size()) + " poses, expected " + std::to_string(n));
-    for (std::size_t i = 0; i < n; ++i) validate(poses[i], "poses[" + std::to_string(i) + "]");
+    validate(poses, n);
     MultiblobSaddlePoint next;
     next.first_blob = system_.first_blob;
     next.bodies = system_.bodies;
@@ -117,9 +115,7 @@ class MultiblobMobility {
   // U = N F, one application.
   VecX apply(const VecX& F) {
     require_configured();
-    if (F.size() != size())
-      fail_argument("F", "has size " + std::to_string(F.size()) + ", expected " + std::to_string(size()));
-    require_finite(F, "F");
+    require_finite(F, size(), "F");
     counter_.count();
     if (dense_) return dense_mobility_ * F;
     return solve_matrix_free(F);

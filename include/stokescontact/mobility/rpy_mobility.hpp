@@ -162,9 +162,7 @@ class RpyMobility {
   // New centres (orientations are irrelevant to spheres but must be valid). Validates
   // everything before changing anything.
   void set_configuration(std::span<const Pose> poses) {
-    if (static_cast<Eigen::Index>(poses.size()) != n_)
-      fail_argument("poses", "has " + std::to_string(poses.size()) + " poses, expected " + std::to_string(n_));
-    for (std::size_t i = 0; i < poses.size(); ++i) validate(poses[i], "poses[" + std::to_string(i) + "]");
+    validate(poses, static_cast<std::size_t>(n_));
     for (Eigen::Index i = 0; i < n_; ++i)
       for (std::size_t d = 0; d < 3; ++d) s_.x[d][i] = poses[static_cast<std::size_t>(i)].x[static_cast<Eigen::Index>(d)];
     configured_ = true;
@@ -173,9 +171,7 @@ class RpyMobility {
   // U = M F, one application; F stacked per sphere (f_i[, tau_i]).
   VecX apply(const VecX& F) {
     require_configured();
-    if (F.size() != size())
-      fail_argument("F", "has size " + std::to_string(F.size()) + ", expected " + std::to_string(size()));
-    if (!F.allFinite()) fail_argument("F", "must be finite");
+    require_finite(F, size(), "F");
     counter_.count();
     for (Eigen::Index i = 0; i < n_; ++i)
       for (Eigen::Index d = 0; d < 3; ++d) {

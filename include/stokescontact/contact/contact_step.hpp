@@ -1,0 +1,342 @@
+#pragma once
+// One contact step (Broms & Tornberg Sec. 2): the problem, options and result shared by
+// every contact solver, and the machinery they share.
+//
+// Given a contact-free configuration Q_t and the unconstrained velocities U (the caller's
+// mobility solve, not counted here), the trial step Q* = Q_t + dt Psi U (eq. 16) flags the
+// Nc pairs with d^P <= d_try (eq. 30/31) and builds the contact matrix D at Q* (eq. 20-21).
+// A solver then looks for contact magnitudes lambda >= 0 so that the corrected configuration
+//     Q(lambda) = Q_t + dt Psi (U + M D lambda)        (eq. 13, M at Q_t)
+// keeps every pair at d >= d_hat. Two cost modes for M D lambda:
+//   formed:      the Nc columns M D are computed once (Nc applications, on first need);
+//                every M D lambda and (M D)^T v is then free;
+//   matrix_free: one application per distinct M D lambda and per D^T M v.
+// lambda = 0 costs nothing in both modes, so a step without contacts costs 0 applications.
+//
+// The guarantee (run_contact_step): after a solve, every pair of the new configuration is
+// checked; a pair that was not flagged and now has d < d_hat (1 - separation_margin) is
+// added (its column from its closest points at Q*) and the step re-solved, warm-started. A
+// step that still violates d_hat reports failed_separation with the numbers, never silently.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <optional>
+#include <set>
+#include <span>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Sparse>
+
+#include "stokescontact/contact/barrier.hpp"
+#include "stokescontact/contact/contact_matrix.hpp"
+#include "stokescontact/contact/contact_pairs.hpp"
+#include "stokescontact/contact/d_try.hpp"
+#include "stokescontact/core/rigid_motion.hpp"
+#include "stokescontact/mobility/mobility_operator.hpp"
+
+namespace stokescontact {
+
+// The step to correct. Spans and U are referenced, not copied: they must outlive the solve.
+template <Shape S>
+struct ContactStepProblem {
+  std::span<const S> shapes;         // one per body, or one shared
+  std::span<const Pose> poses;       // Q_t, contact free (every d^P >= 0)
+  const VecX* U = nullptr;           // unconstrained velocities, N * mobility.dofs_per_body()
+  double dt = 0.0;                   // > 0
+  double d_hat = 0.0;                // > 0, the smallest distance allowed at t + dt
+  double d_try = 0.0;                // 0: eq. 31 (dofs 3) or eq. 30 (dofs 6) times the multiplier
+  double d_try_multiplier = 1.0;     // >= 1
+  std::optional<PeriodicBox> box;    // periodic box, none for open space
+};
+
+enum class MobilityCost { formed, matrix_free };
+
+struct ContactStepOptions {
+  MobilityCost cost = MobilityCost::formed;
+  // A pair is separated when d >= d_hat (1 - separation_margin).
+  double separation_margin = 1e-3;
+  // Re-solves after adding pairs the trial step missed (the guarantee loop).
+  int max_guarantee_rounds = 3;
+
+  void validate() const {
+    if (!(separation_margin >= 0.0 && separation_margin < 1.0))
+      fail_argument("ContactStepOptions.separation_margin",
+                    "must lie in [0, 1), got " + std::to_string(separation_margin));
+    if (max_guarantee_rounds < 0)
+      fail_argument("ContactStepOptions.max_guarantee_rounds",
+                    "must be >= 0, got " + std::to_string(max_guarantee_rounds));
+  }
+};
+
+enum class ContactStepStatus { converged, not_converged, failed_separation };
+
+// The same result for every solver.
+struct ContactStepResult {
+  ContactStepStatus status = ContactStepStatus::converged;
+  std::string message;                  // what happened, with the numbers when not converged
+  VecX lambda;                          // contact magnitudes, one per flagged pair, >= 0
+  std::vector<ContactPair> pairs;       // the flagged pairs at Q* (missed ones appended)
+  VecX contact_forces;                  // D lambda: forces (and torques) per body
+  VecX velocities;                      // U + M D lambda
+  std::vector<Pose> poses;              // Q(lambda), the new configuration
+  int iterations = 0;                   // solver iterations over all rounds (see each solver)
+  std::size_t mobility_applications = 0;
+  double wall_time_s = 0.0;
+  double d_try = 0.0;                   // the threshold used
+  double min_distance_ratio = 0.0;      // min d^P over all pairs of Q(lambda) / d_hat (inf: < 2 bodies)
+  double barrier_energy = 0.0;          // sum b(d_k) over flagged pairs at Q(lambda), eq. 10 with eps_reg = d_try
+  // max_k min(lambda_k / max lambda, (d_k - d_hat)_+ / d_hat): 0 when every pushed pair sits at d_hat.
+  double complementarity_residual = 0.0;
+  double lambda_sum = 0.0;
+  double lambda_max = 0.0;
+  std::size_t flagged_pairs = 0;        // Nc
+  int guarantee_rounds = 0;             // re-solves after adding missed pairs
+};
+
+// What a solver's core returns for one round: lambda and its own convergence.
+struct ContactSolveOutcome {
+  VecX lambda;
+  int iterations = 0;
+  bool converged = false;
+  std::string message;
+};
+
+// Q(lambda) with its flagged-pair distances and closest points.
+struct ContactEvaluation {
+  VecX lambda;
+  VecX MD_lambda;  // M D lambda
+  std::vector<Pose> poses;
+  std::vector<ContactPair> pairs;  // the flagged pairs re-measured at Q(lambda)
+  VecX distances;
+
+  double min_distance() const { return distances.size() == 0 ? INFINITY : distances.minCoeff(); }
+};
+
+// The shared machinery of one step: Q*, flagged pairs, D, M D lambda, Q(lambda), distances.
+template <Shape S, MobilityOperator M>
+class ContactStep {
+ public:
+  // Validates everything (std::invalid_argument naming the field) before touching `mobility`.
+  ContactStep(const ContactStepProblem<S>& problem, M& mobility, const ContactStepOptions& options)
+      : problem_(problem), mobility_(mobility), options_(options) {
+    options.validate();
+    validate_scene(problem.shapes, problem.poses);
+    require_positive(problem.dt, "dt");
+    require_positive(problem.d_hat, "d_hat");
+    if (problem.U == nullptr) fail_argument("U", "must be given");
+    dofs_ = mobility.dofs_per_body();
+    detail::require_velocities(*problem.U, problem.poses.size(), dofs_);
+    if (mobility.size() != static_cast<Eigen::Index>(problem.poses.size()) * dofs_)
+      fail_argument("mobility", "has size " + std::to_string(mobility.size()) + ", expected " +
+                                    std::to_string(problem.poses.size() * static_cast<std::size_t>(dofs_)));
+    if (problem.box) require_finite(problem.box->lengths, "box.lengths");
+    const MinimumDistance start = minimum_pair_distance(problem.shapes, problem.poses, problem.box);
+    if (start.distance < 0.0)
+      fail_argument("poses", "Q_t must be contact free; bodies " + std::to_string(start.i) + " and " +
+                                 std::to_string(start.j) + " overlap, d = " + std::to_string(start.distance));
+    d_try_ = problem.d_try;
+    if (d_try_ == 0.0) {
+      d_try_ = dofs_ == 3 ? d_try_spheres(problem.d_hat, problem.dt, *problem.U, 3, problem.d_try_multiplier)
+                          : d_try_tip_velocity(problem.d_hat, problem.dt, problem.shapes, problem.poses, *problem.U,
+                                               problem.d_try_multiplier);
+    } else {
+      require_positive(d_try_, "d_try");
+      if (!(d_try_ >= problem.d_hat))
+        fail_argument("d_try", "must be >= d_hat = " + std::to_string(problem.d_hat) + ", got " +
+                                   std::to_string(d_try_));
+    }
+    // Everything checked: now change state.
+    start_applications_ = mobility.applications();
+    mobility.set_configuration(problem.poses);  // M at Q_t (eq. 13)
+    trial_ = advance_all(*problem.U);           // eq. 16
+    pairs_ = find_contact_pairs(problem.shapes, std::span<const Pose>(trial_), d_try_, problem.box);
+    rebuild();
+  }
+
+  // Adds pairs (i < j) not yet flagged, measured at Q*; returns how many were new.
+  std::size_t add_pairs(std::span<const ContactPair> found) {
+    std::set<std::pair<Eigen::Index, Eigen::Index>> known;
+    for (const ContactPair& p : pairs_) known.insert({p.i, p.j});
+    std::size_t added = 0;
+    for (const ContactPair& p : found)
+      if (known.insert({p.i, p.j}).second) {
+        pairs_.push_back(detail::contact_pair(problem_.shapes, std::span<const Pose>(trial_), p.i, p.j, problem_.box));
+        ++added;
+      }
+    if (added > 0) rebuild();
+    return added;
+  }
+
+  // M D lambda: free for lambda = 0 and in formed mode (after forming), else one application.
+  VecX MD_times(const VecX& lambda) {
+    if (lambda.isZero(0.0)) return VecX::Zero(mobility_.size());
+    if (options_.cost == MobilityCost::formed) return formed_MD() * lambda;
+    return mobility_.apply(VecX(D_ * lambda));
+  }
+
+  // (M D)^T v = D^T M v (M symmetric): free in formed mode, else one application.
+  VecX MD_transpose_times(const VecX& v) {
+    if (v.isZero(0.0)) return VecX::Zero(nc());
+    if (options_.cost == MobilityCost::formed) return formed_MD().transpose() * v;
+    return D_.transpose() * mobility_.apply(v);
+  }
+
+  // A x = dt D^T M D x, the LCP matrix about Q* (eq. 26 with d^P): one application, or free when formed.
+  VecX A_times(const VecX& x) { return problem_.dt * (D_.transpose() * MD_times(x)); }
+
+  // Q(lambda) and the flagged-pair distances there; the last evaluation is cached.
+  const ContactEvaluation& evaluate(const VecX& lambda) {
+    if (last_ && last_->lambda.size() == lambda.size() && last_->lambda == lambda) return *last_;
+    ContactEvaluation e;
+    e.lambda = lambda;
+    e.MD_lambda = MD_times(lambda);
+    e.poses = advance_all(*problem_.U + e.MD_lambda);
+    e.pairs.reserve(pairs_.size());
+    e.distances.resize(nc());
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+      e.pairs.push_back(
+          detail::contact_pair(problem_.shapes, std::span<const Pose>(e.poses), pairs_[k].i, pairs_[k].j, problem_.box));
+      e.distances(static_cast<Eigen::Index>(k)) = e.pairs.back().points.distance;
+    }
+    last_ = std::move(e);
+    return *last_;
+  }
+
+  // The contact matrix of the flagged pairs at an evaluated configuration: D_k, with
+  // D_k^T U = the rate of change of their distances there.
+  Eigen::SparseMatrix<double> contact_matrix_at(const ContactEvaluation& e) const {
+    return contact_matrix(std::span<const ContactPair>(e.pairs), std::span<const Pose>(e.poses), dofs_);
+  }
+
+  // The barrier of eq. 15: b of eq. 10 with eps_reg = d_try (Remark 4).
+  BarrierParameters barrier_parameters_eq15() const { return barrier_parameters(problem_.d_hat, d_try_); }
+
+  bool separated(double d) const { return d >= problem_.d_hat * (1.0 - options_.separation_margin); }
+  bool all_separated(const ContactEvaluation& e) const { return nc() == 0 || separated(e.min_distance()); }
+
+  Eigen::Index nc() const { return static_cast<Eigen::Index>(pairs_.size()); }
+  const Eigen::SparseMatrix<double>& D() const { return D_; }
+  const std::vector<ContactPair>& pairs() const { return pairs_; }
+  const ContactStepProblem<S>& problem() const { return problem_; }
+  const ContactStepOptions& options() const { return options_; }
+  double d_try() const { return d_try_; }
+  std::size_t applications() const { return mobility_.applications() - start_applications_; }
+
+ private:
+  std::vector<Pose> advance_all(const VecX& velocities) const {
+    std::vector<Pose> next(problem_.poses.size());
+    for (std::size_t b = 0; b < next.size(); ++b) {
+      const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs_;
+      const Vec3 omega = dofs_ == 6 ? Vec3(velocities.segment<3>(row + 3)) : Vec3::Zero();
+      next[b] = advance(problem_.poses[b], velocities.segment<3>(row), omega, problem_.dt);
+    }
+    return next;
+  }
+
+  void rebuild() {
+    D_ = contact_matrix(std::span<const ContactPair>(pairs_), std::span<const Pose>(trial_), dofs_);
+    MD_.reset();
+    last_.reset();
+  }
+
+  const MatX& formed_MD() {
+    if (!MD_) {
+      MatX md(mobility_.size(), nc());
+      for (Eigen::Index k = 0; k < nc(); ++k) md.col(k) = mobility_.apply(VecX(D_.col(k)));
+      MD_ = std::move(md);
+    }
+    return *MD_;
+  }
+
+  ContactStepProblem<S> problem_;
+  M& mobility_;
+  ContactStepOptions options_;
+  int dofs_ = 6;
+  double d_try_ = 0.0;
+  std::size_t start_applications_ = 0;
+  std::vector<Pose> trial_;  // Q*
+  std::vector<ContactPair> pairs_;
+  Eigen::SparseMatrix<double> D_;
+  std::optional<MatX> MD_;
+  std::optional<ContactEvaluation> last_;
+};
+
+namespace detail {
+
+inline double complementarity_residual(const VecX& lambda, const VecX& distances, double d_hat) {
+  if (lambda.size() == 0) return 0.0;
+  const double lambda_max = lambda.maxCoeff();
+  if (!(lambda_max > 0.0)) return 0.0;
+  double r = 0.0;
+  for (Eigen::Index k = 0; k < lambda.size(); ++k)
+    r = std::max(r, std::min(lambda(k) / lambda_max, std::max(0.0, distances(k) - d_hat) / d_hat));
+  return r;
+}
+
+inline VecX padded(const VecX& lambda, Eigen::Index size) {
+  VecX out = VecX::Zero(size);
+  out.head(std::min(size, lambda.size())) = lambda.head(std::min(size, lambda.size()));
+  return out;
+}
+
+}  // namespace detail
+
+// Runs a solver core `solve(step, warm_start) -> ContactSolveOutcome` inside the guarantee loop
+// and fills the result. Bad input throws std::invalid_argument before anything changes.
+template <Shape S, MobilityOperator M, typename Solve>
+ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobility,
+                                   const ContactStepOptions& options, Solve&& solve) {
+  const auto start = std::chrono::steady_clock::now();
+  ContactStep<S, M> step(problem, mobility, options);
+  ContactStepResult r;
+  ContactSolveOutcome outcome;
+  std::vector<ContactPair> violating;
+  for (int round = 0;; ++round) {
+    const int iterations = r.iterations;
+    outcome = solve(step, detail::padded(outcome.lambda, step.nc()));
+    r.iterations = iterations + outcome.iterations;
+    r.guarantee_rounds = round;
+    const ContactEvaluation& e = step.evaluate(outcome.lambda);
+    // The check over all pairs, not only the flagged ones.
+    violating = find_contact_pairs(problem.shapes, std::span<const Pose>(e.poses),
+                                   problem.d_hat * (1.0 - options.separation_margin), problem.box);
+    std::erase_if(violating, [&](const ContactPair& p) { return step.separated(p.points.distance); });
+    if (violating.empty() || round == options.max_guarantee_rounds || step.add_pairs(violating) == 0) break;
+  }
+  const ContactEvaluation& e = step.evaluate(outcome.lambda);
+  r.lambda = outcome.lambda;
+  r.pairs = step.pairs();
+  r.flagged_pairs = r.pairs.size();
+  r.contact_forces = step.D() * r.lambda;
+  r.velocities = *problem.U + e.MD_lambda;
+  r.poses = e.poses;
+  r.d_try = step.d_try();
+  r.min_distance_ratio =
+      minimum_pair_distance(problem.shapes, std::span<const Pose>(r.poses), problem.box).distance / problem.d_hat;
+  const std::vector<double> d(e.distances.begin(), e.distances.end());
+  r.barrier_energy = barrier_energy(d, step.barrier_parameters_eq15());
+  r.complementarity_residual = detail::complementarity_residual(r.lambda, e.distances, problem.d_hat);
+  r.lambda_sum = r.lambda.sum();
+  r.lambda_max = r.lambda.size() == 0 ? 0.0 : r.lambda.maxCoeff();
+  r.mobility_applications = step.applications();
+  if (!violating.empty()) {
+    std::ostringstream os;
+    os << "failed separation: " << violating.size() << " pair(s) below d_hat (1 - " << options.separation_margin
+       << ") after " << r.guarantee_rounds << " guarantee round(s); min d / d_hat = " << r.min_distance_ratio
+       << " (bodies " << violating.front().i << ", " << violating.front().j << ")";
+    if (!outcome.message.empty()) os << "; solver: " << outcome.message;
+    r.status = ContactStepStatus::failed_separation;
+    r.message = os.str();
+  } else {
+    r.status = outcome.converged ? ContactStepStatus::converged : ContactStepStatus::not_converged;
+    r.message = outcome.message;
+  }
+  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+}  // namespace stokescontact

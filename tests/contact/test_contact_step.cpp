@@ -1,0 +1,354 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "contact/random_scenes.hpp"
+#include "stokescontact/contact/contact_step.hpp"
+#include "stokescontact/contact/solver_barrier_nlopt.hpp"
+#include "stokescontact/contact/solver_lcp_sequence.hpp"
+#include "stokescontact/mobility/free_draining.hpp"
+
+namespace sc = stokescontact;
+
+namespace {
+
+using contact_test::expect_rejects;
+using contact_test::uniform;
+using test_support::random_rotation;
+using test_support::random_unit_vector;
+
+// Every solver behind the one interface.
+enum class Solver { kLcpBbpgd, kLcpApgd, kLcpNewton, kBarrierSlsqp, kBarrierCobyla, kBarrierMma };
+const std::vector<Solver> kAllSolvers = {Solver::kLcpBbpgd,     Solver::kLcpApgd,       Solver::kLcpNewton,
+                                         Solver::kBarrierSlsqp, Solver::kBarrierCobyla, Solver::kBarrierMma};
+
+std::string solver_name(Solver s) {
+  switch (s) {
+    case Solver::kLcpBbpgd: return "lcp_sequence/bbpgd";
+    case Solver::kLcpApgd: return "lcp_sequence/apgd";
+    case Solver::kLcpNewton: return "lcp_sequence/minimum_map_newton";
+    case Solver::kBarrierSlsqp: return "barrier/slsqp";
+    case Solver::kBarrierCobyla: return "barrier/cobyla";
+    case Solver::kBarrierMma: return "barrier/mma";
+  }
+  return "?";
+}
+
+bool is_barrier(Solver s) { return s == Solver::kBarrierSlsqp || s == Solver::kBarrierCobyla || s == Solver::kBarrierMma; }
+
+template <sc::Shape S, sc::MobilityOperator M>
+sc::ContactStepResult run(Solver s, const sc::ContactStepProblem<S>& p, M& mobility,
+                          const sc::ContactStepOptions& options = {}) {
+  sc::LcpSequenceOptions seq;
+  sc::BarrierNloptOptions bar;
+  switch (s) {
+    case Solver::kLcpBbpgd: seq.inner = sc::InnerLcpSolver::bbpgd; break;
+    case Solver::kLcpApgd: seq.inner = sc::InnerLcpSolver::apgd; break;
+    case Solver::kLcpNewton: seq.inner = sc::InnerLcpSolver::minimum_map_newton; break;
+    case Solver::kBarrierSlsqp: bar.optimizer = sc::BarrierOptimizer::slsqp; break;
+    case Solver::kBarrierCobyla: bar.optimizer = sc::BarrierOptimizer::cobyla; break;
+    case Solver::kBarrierMma: bar.optimizer = sc::BarrierOptimizer::mma; break;
+  }
+  if (is_barrier(s)) return sc::solve_contact_step_barrier(p, mobility, options, bar);
+  return sc::solve_contact_step_lcp_sequence(p, mobility, options, seq);
+}
+
+void print(const std::string& scene, Solver s, const sc::ContactStepResult& r) {
+  std::printf("[%s] %-32s status %d Nc %zu iters %d apps %zu sum %.6g max %.6g min d/d_hat %.6f E %.3g compl %.3g "
+              "rounds %d %.2f ms %s\n",
+              scene.c_str(), solver_name(s).c_str(), static_cast<int>(r.status), r.flagged_pairs, r.iterations,
+              r.mobility_applications, r.lambda_sum, r.lambda_max, r.min_distance_ratio, r.barrier_energy,
+              r.complementarity_residual, r.guarantee_rounds, 1e3 * r.wall_time_s, r.message.c_str());
+}
+
+// Unit spheres in viscosity 1, translation only: mobility mu = 1 / (6 pi) each.
+constexpr double kMu = 1.0 / (6.0 * std::numbers::pi);
+
+struct SphereScene {
+  std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  std::vector<sc::Pose> poses;
+  sc::VecX U;
+  double dt = 0.01;
+  double d_hat = 0.01;
+  double d_try = 0.0;
+
+  sc::FreeDrainingMobility mobility() const {
+    return sc::FreeDrainingMobility(sc::sphere_mobility(shapes[0], 1.0), poses.size(), 3);
+  }
+  sc::ContactStepProblem<sc::Sphere> problem() const {
+    return {shapes, poses, &U, dt, d_hat, d_try, 1.0, {}};
+  }
+};
+
+// Two unit spheres on the x axis, gap g, moving towards each other at speed v each.
+SphereScene head_on(double gap, double v) {
+  SphereScene s;
+  s.poses = {sc::Pose{sc::Vec3(0, 0, 0), sc::Quat::Identity()}, sc::Pose{sc::Vec3(2.0 + gap, 0, 0), sc::Quat::Identity()}};
+  s.U.resize(6);
+  s.U << v, 0, 0, -v, 0, 0;
+  return s;
+}
+
+// Nonoverlapping unit spheres in [0, side)^3 (rejection, gap >= 0.05), random velocities of size speed.
+SphereScene random_spheres(std::uint64_t seed, int n, double side, double speed) {
+  std::mt19937_64 rng(seed);
+  SphereScene s;
+  while (static_cast<int>(s.poses.size()) < n) {
+    const sc::Vec3 x = test_support::uniform_vector(rng, 1.0, side - 1.0);
+    if (std::all_of(s.poses.begin(), s.poses.end(), [&](const sc::Pose& p) { return (p.x - x).norm() > 2.05; }))
+      s.poses.push_back({x, sc::Quat::Identity()});
+  }
+  s.U.resize(3 * n);
+  for (int i = 0; i < n; ++i) s.U.segment<3>(3 * i) = speed * random_unit_vector(rng);
+  s.dt = 0.02;
+  s.d_hat = 0.02;
+  return s;
+}
+
+void expect_third_law(const sc::ContactStepResult& r, int dofs) {
+  sc::Vec3 total = sc::Vec3::Zero();
+  for (Eigen::Index b = 0; b < r.contact_forces.size(); b += dofs) total += r.contact_forces.segment<3>(b);
+  EXPECT_LE(total.norm(), 1e-14 * std::max(1.0, r.lambda_sum));
+}
+
+// ---------------------------------------------------------------------------------------
+
+// d(lambda) = d* + dt 2 mu lambda along the line of centres (D^T M D = 2 mu), so the smallest
+// lambda with d = d_hat is lambda* = (d_hat - d*) / (2 mu dt), d* = gap - 2 v dt.
+TEST(ContactStep, TwoSpheresHeadOnMatchClosedFormForEverySolver) {
+  const SphereScene s = head_on(0.1, 10.0);
+  const double d_star = 0.1 - 2.0 * 10.0 * s.dt;
+  const double lambda_star = (s.d_hat - d_star) / (2.0 * kMu * s.dt);
+  for (const Solver solver : kAllSolvers)
+    for (const sc::MobilityCost cost : {sc::MobilityCost::formed, sc::MobilityCost::matrix_free}) {
+      SCOPED_TRACE(solver_name(solver) + (cost == sc::MobilityCost::formed ? " formed" : " matrix_free"));
+      auto m = s.mobility();
+      sc::ContactStepOptions options;
+      options.cost = cost;
+      const sc::ContactStepResult r = run(solver, s.problem(), m, options);
+      print("head_on", solver, r);
+      EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+      ASSERT_EQ(r.lambda.size(), 1);
+      EXPECT_EQ(r.flagged_pairs, 1u);
+      // The LCP sequence is exact (one LCP); the barrier stops within the separation margin.
+      EXPECT_NEAR(r.lambda(0), lambda_star, (is_barrier(solver) ? 2e-3 : 1e-8) * lambda_star);
+      EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+      EXPECT_NEAR(r.velocities(0), 10.0 - kMu * r.lambda(0), 1e-12 * lambda_star);
+      EXPECT_DOUBLE_EQ(r.barrier_energy, r.barrier_energy);  // finite
+      expect_third_law(r, 3);
+      if (cost == sc::MobilityCost::formed) {
+        EXPECT_EQ(r.mobility_applications, 1u);  // M D, Nc = 1 column
+      } else {
+        EXPECT_GE(r.mobility_applications, 1u);
+      }
+    }
+}
+
+TEST(ContactStep, NoContactsCostNothingAndReturnTheTrialStep) {
+  const SphereScene s = head_on(5.0, 1.0);
+  for (const Solver solver : kAllSolvers) {
+    SCOPED_TRACE(solver_name(solver));
+    auto m = s.mobility();
+    const sc::ContactStepResult r = run(solver, s.problem(), m);
+    EXPECT_EQ(r.status, sc::ContactStepStatus::converged);
+    EXPECT_EQ(r.lambda.size(), 0);
+    EXPECT_EQ(r.flagged_pairs, 0u);
+    EXPECT_EQ(r.mobility_applications, 0u);  // the unconstrained solve is the caller's
+    EXPECT_EQ(r.iterations, 0);
+    EXPECT_EQ(r.velocities, s.U);
+    EXPECT_DOUBLE_EQ(r.poses[0].x.x(), s.dt * 1.0);
+    EXPECT_DOUBLE_EQ(r.min_distance_ratio, (5.0 - 2.0 * s.dt) / s.d_hat);
+  }
+}
+
+// A third sphere sits within d_try of sphere 0 but is never pushed into: its lambda is ~0.
+TEST(ContactStep, PairsThatStayApartGetNoForce) {
+  SphereScene s = head_on(0.1, 10.0);
+  s.poses.push_back({sc::Vec3(0, 2.08, 0), sc::Quat::Identity()});
+  s.U.conservativeResize(9);
+  s.U.tail<3>().setZero();
+  for (const Solver solver : kAllSolvers) {
+    SCOPED_TRACE(solver_name(solver));
+    auto m = s.mobility();
+    const sc::ContactStepResult r = run(solver, s.problem(), m);
+    print("stay_apart", solver, r);
+    EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+    ASSERT_EQ(r.flagged_pairs, 2u);
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+      if (r.pairs[k].j == 2) {
+        EXPECT_LE(r.lambda(static_cast<Eigen::Index>(k)), (is_barrier(solver) ? 1e-2 : 1e-10) * r.lambda_max);
+      }
+    }
+    // The barrier stops by eq. 29 (TOL = 1e-2), not at exact complementarity.
+    EXPECT_LE(r.complementarity_residual, is_barrier(solver) ? 5e-2 : 1e-6);
+    expect_third_law(r, 3);
+  }
+}
+
+TEST(ContactStep, SolversAgreeOnRandomSphereScenes) {
+  for (const std::uint64_t seed : {11u, 12u, 13u}) {
+    const SphereScene s = random_spheres(seed, 30, 8.0, 10.0);
+    std::vector<sc::ContactStepResult> results;
+    for (const Solver solver : kAllSolvers) {
+      auto m = s.mobility();
+      results.push_back(run(solver, s.problem(), m));
+      print("spheres seed " + std::to_string(seed), solver, results.back());
+    }
+    const double reference = results[2].lambda_sum;  // minimum-map Newton sequence
+    for (std::size_t k = 0; k < results.size(); ++k) {
+      SCOPED_TRACE(solver_name(kAllSolvers[k]) + " seed " + std::to_string(seed));
+      const sc::ContactStepResult& r = results[k];
+      EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+      EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+      EXPECT_NEAR(r.lambda_sum, reference, 2e-2 * reference);
+      expect_third_law(r, 3);
+    }
+  }
+}
+
+// A few spherocylinders with random velocities and rotations, 6 dofs per body, eq. 30.
+TEST(ContactStep, SolversAgreeOnRodScenes) {
+  const sc::Spherocylinder rod{4.0, 0.5};
+  const std::vector<sc::Spherocylinder> shapes{rod};
+  for (const std::uint64_t seed : {21u, 22u, 23u}) {
+    std::mt19937_64 rng(seed);
+    std::vector<sc::Pose> poses;
+    while (poses.size() < 10) {
+      const sc::Pose p{test_support::uniform_vector(rng, 0.0, 5.0), random_rotation(rng)};
+      bool ok = true;
+      for (const sc::Pose& q : poses) ok = ok && sc::closest_points(rod, p, rod, q).distance > 0.05;
+      if (ok) poses.push_back(p);
+    }
+    sc::VecX U(6 * static_cast<Eigen::Index>(poses.size()));
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      U.segment<3>(6 * static_cast<Eigen::Index>(i)) = 10.0 * random_unit_vector(rng);
+      U.segment<3>(6 * static_cast<Eigen::Index>(i) + 3) = 3.0 * random_unit_vector(rng);
+    }
+    const sc::ContactStepProblem<sc::Spherocylinder> p{shapes, poses, &U, 0.02, 0.02, 0.0, 1.0, {}};
+    std::vector<sc::ContactStepResult> results;
+    for (const Solver solver : kAllSolvers) {
+      sc::FreeDrainingMobility m(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
+      results.push_back(run(solver, p, m));
+      print("rods seed " + std::to_string(seed), solver, results.back());
+    }
+    const double reference = results[2].lambda_sum;
+    for (std::size_t k = 0; k < results.size(); ++k) {
+      SCOPED_TRACE(solver_name(kAllSolvers[k]) + " seed " + std::to_string(seed));
+      const sc::ContactStepResult& r = results[k];
+      EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+      EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+      EXPECT_NEAR(r.lambda_sum, reference, 5e-2 * reference + 1e-12);
+      expect_third_law(r, 6);
+    }
+  }
+}
+
+// Three spheres in a row, d_try = d_hat: pair (1, 2) is not flagged at Q*, but pushing sphere 1
+// away from sphere 0 drives it into sphere 2. The guarantee loop adds the pair and re-solves.
+SphereScene chain() {
+  SphereScene s = head_on(0.1, 20.0);
+  s.poses.push_back({sc::Vec3(4.1 + 0.03, 0, 0), sc::Quat::Identity()});
+  s.U.resize(9);
+  s.U << 20, 0, 0, 0, 0, 0, 0, 0, 0;
+  s.d_try = s.d_hat;
+  return s;
+}
+
+TEST(ContactStep, GuaranteeLoopCatchesPairsTheTrialStepMissed) {
+  const SphereScene s = chain();
+  for (const Solver solver : kAllSolvers) {
+    SCOPED_TRACE(solver_name(solver));
+    auto m = s.mobility();
+    const sc::ContactStepResult r = run(solver, s.problem(), m);
+    print("chain", solver, r);
+    EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+    EXPECT_EQ(r.flagged_pairs, 2u);
+    EXPECT_GE(r.guarantee_rounds, 1);
+    EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+    expect_third_law(r, 3);
+  }
+}
+
+TEST(ContactStep, GuaranteeFailureIsReportedNotHidden) {
+  const SphereScene s = chain();
+  sc::ContactStepOptions options;
+  options.max_guarantee_rounds = 0;
+  for (const Solver solver : {Solver::kLcpNewton, Solver::kBarrierSlsqp}) {
+    auto m = s.mobility();
+    const sc::ContactStepResult r = run(solver, s.problem(), m, options);
+    EXPECT_EQ(r.status, sc::ContactStepStatus::failed_separation);
+    EXPECT_NE(r.message.find("failed separation"), std::string::npos) << r.message;
+    EXPECT_LT(r.min_distance_ratio, 1.0 - 1e-3);
+  }
+}
+
+// A dense random scene with d_try deliberately at d_hat: whatever the trial step misses, the
+// result separates every pair or says it did not.
+TEST(ContactStep, DenseSceneWithSmallDTryIsSeparatedOrReported) {
+  SphereScene s = random_spheres(31, 27, 7.5, 8.0);
+  s.d_try = s.d_hat;
+  for (const Solver solver : {Solver::kLcpNewton, Solver::kBarrierSlsqp}) {
+    SCOPED_TRACE(solver_name(solver));
+    auto m = s.mobility();
+    const sc::ContactStepResult r = run(solver, s.problem(), m);
+    print("dense small d_try", solver, r);
+    if (r.status == sc::ContactStepStatus::converged) {
+      EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+    } else {
+      EXPECT_FALSE(r.message.empty());
+    }
+  }
+}
+
+TEST(ContactStep, RejectsBadInputNamingTheFieldAndChangesNothing) {
+  const SphereScene good = head_on(0.1, 10.0);
+  const auto check = [&](auto mutate, const std::string& field) {
+    SphereScene s = good;
+    sc::ContactStepProblem<sc::Sphere> p = s.problem();
+    sc::ContactStepOptions options;
+    mutate(s, p, options);
+    auto m = good.mobility();
+    expect_rejects([&] { (void)sc::solve_contact_step_lcp_sequence(p, m, options); }, field);
+    expect_rejects([&] { (void)sc::solve_contact_step_barrier(p, m, options); }, field);
+    EXPECT_EQ(m.applications(), 0u);
+    EXPECT_THROW((void)m.apply(sc::VecX::Zero(6)), std::logic_error);  // never configured
+  };
+  using P = sc::ContactStepProblem<sc::Sphere>;
+  using O = sc::ContactStepOptions;
+  check([](SphereScene&, P& p, O&) { p.dt = 0.0; }, "dt");
+  check([](SphereScene&, P& p, O&) { p.dt = NAN; }, "dt");
+  check([](SphereScene&, P& p, O&) { p.d_hat = -1.0; }, "d_hat");
+  check([](SphereScene&, P& p, O&) { p.U = nullptr; }, "U");
+  check([](SphereScene& s, P& p, O&) { s.U.resize(5); p.U = &s.U; }, "U");
+  check([](SphereScene& s, P& p, O&) { s.U(2) = INFINITY; p.U = &s.U; }, "U");
+  check([](SphereScene& s, P& p, O&) { s.poses[1].x.x() = 1.5; p.poses = s.poses; }, "poses");  // overlap
+  check([](SphereScene& s, P& p, O&) { s.poses[1].q.w() = 2.0; p.poses = s.poses; }, "poses[1].q");
+  check([](SphereScene&, P& p, O&) { p.d_try = 0.5 * p.d_hat; }, "d_try");
+  check([](SphereScene&, P& p, O&) { p.d_try_multiplier = 0.5; }, "multiplier");
+  check([](SphereScene& s, P& p, O&) { s.shapes = {sc::Sphere{1.0}, sc::Sphere{1.0}, sc::Sphere{1.0}}; p.shapes = s.shapes; },
+        "shapes");
+  check([](SphereScene& s, P& p, O&) { s.shapes = {sc::Sphere{-1.0}}; p.shapes = s.shapes; }, "Sphere.radius");
+  check([](SphereScene&, P&, O& o) { o.separation_margin = 1.0; }, "separation_margin");
+  check([](SphereScene&, P&, O& o) { o.max_guarantee_rounds = -1; }, "max_guarantee_rounds");
+
+  auto m = good.mobility();
+  const P p = good.problem();
+  sc::LcpSequenceOptions seq;
+  seq.max_iterations = 0;
+  expect_rejects([&] { (void)sc::solve_contact_step_lcp_sequence(p, m, {}, seq); }, "LcpSequenceOptions.max_iterations");
+  sc::BarrierNloptOptions bar;
+  bar.tol = 0.0;
+  expect_rejects([&] { (void)sc::solve_contact_step_barrier(p, m, {}, bar); }, "BarrierNloptOptions.tol");
+  sc::FreeDrainingMobility wrong(sc::sphere_mobility(sc::Sphere{1.0}, 1.0), 3, 3);  // 3 bodies for 2 poses
+  expect_rejects([&] { (void)sc::solve_contact_step_lcp_sequence(p, wrong); }, "mobility");
+  EXPECT_EQ(m.applications(), 0u);
+}
+
+}  // namespace
