@@ -8,7 +8,8 @@
 // A solver then looks for contact magnitudes lambda >= 0 so that the corrected configuration
 //     Q(lambda) = Q_t + dt Psi (U + M D lambda)        (eq. 13, M at Q_t)
 // keeps every pair at d >= d_hat. Two cost modes for M D lambda:
-//   formed:      the Nc columns M D are computed once (Nc applications, on first need);
+//   formed:      the Nc columns M D are computed once (Nc applications, on first need; a
+//                pair added by the guarantee loop costs one more);
 //                every M D lambda and (M D)^T v is then free;
 //   matrix_free: one application per distinct M D lambda and per D^T M v.
 // lambda = 0 costs nothing in both modes, so a step without contacts costs 0 applications.
@@ -237,19 +238,20 @@ class ContactStep {
     return next;
   }
 
+  // Pairs are only ever appended: columns of M D already formed stay valid.
   void rebuild() {
     D_ = contact_matrix(std::span<const ContactPair>(pairs_), std::span<const Pose>(trial_), dofs_);
-    MD_.reset();
     last_.reset();
   }
 
+  // M D, forming only the columns not yet formed (one application each).
   const MatX& formed_MD() {
-    if (!MD_) {
-      MatX md(mobility_.size(), nc());
-      for (Eigen::Index k = 0; k < nc(); ++k) md.col(k) = mobility_.apply(VecX(D_.col(k)));
-      MD_ = std::move(md);
+    const Eigen::Index formed = MD_.cols();
+    if (formed < nc()) {
+      MD_.conservativeResize(mobility_.size(), nc());
+      for (Eigen::Index k = formed; k < nc(); ++k) MD_.col(k) = mobility_.apply(VecX(D_.col(k)));
     }
-    return *MD_;
+    return MD_;
   }
 
   ContactStepProblem<S> problem_;
@@ -261,7 +263,7 @@ class ContactStep {
   std::vector<Pose> trial_;  // Q*
   std::vector<ContactPair> pairs_;
   Eigen::SparseMatrix<double> D_;
-  std::optional<MatX> MD_;
+  MatX MD_;  // the columns of M D formed so far
   std::optional<ContactEvaluation> last_;
 };
 

@@ -33,13 +33,15 @@
 
 namespace stokescontact {
 
+// SLSQP (gradient, the default), MMA (gradient, CCSA), COBYLA (derivative-free: fine for a
+// handful of pairs, but in our tests it needs more than 1000 evaluations from Nc ~ 20 on).
 enum class BarrierOptimizer { slsqp, cobyla, mma };
 
 struct BarrierNloptOptions {
   BarrierOptimizer optimizer = BarrierOptimizer::slsqp;
   double tol = 1e-2;                 // eq. 29
   double eps_reg = -1.0;             // < 0: d_try (Remark 4)
-  int max_evaluations = 500;         // barrier-energy evaluations per round
+  int max_evaluations = 1000;        // barrier-energy evaluations per round
   double cap_fraction = 1e-2;        // eps_cap = cap_fraction (d_hat + eps_reg)
 
   void validate() const {
