@@ -43,12 +43,15 @@
 #include "stokescontact/contact/barrier.hpp"
 #include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/contact/contact_pairs.hpp"
+#include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/d_try.hpp"
 #include "stokescontact/contact/lcp.hpp"
 #include "stokescontact/contact/lcp_apgd.hpp"
 #include "stokescontact/contact/lcp_bbpgd.hpp"
 #include "stokescontact/contact/lcp_minimum_map_newton.hpp"
 #include "stokescontact/contact/scene.hpp"
+#include "stokescontact/contact/solver_barrier_nlopt.hpp"
+#include "stokescontact/contact/solver_lcp_sequence.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
 
 // io

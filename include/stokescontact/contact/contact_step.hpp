@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <set>
 #include <span>
@@ -49,7 +50,8 @@ struct ContactStepProblem {
   const VecX* U = nullptr;           // unconstrained velocities, N * mobility.dofs_per_body()
   double dt = 0.0;                   // > 0
   double d_hat = 0.0;                // > 0, the smallest distance allowed at t + dt
-  double d_try = 0.0;                // 0: eq. 31 (dofs 3) or eq. 30 (dofs 6) times the multiplier
+  double d_try = 0.0;                // 0: eq. 31 (dofs 3) or eq. 30 (dofs 6) times the multiplier;
+                                     // > 0: used as given (>= d_hat), the multiplier ignored
   double d_try_multiplier = 1.0;     // >= 1
   std::optional<PeriodicBox> box;    // periodic box, none for open space
 };
@@ -114,7 +116,9 @@ struct ContactEvaluation {
   std::vector<ContactPair> pairs;  // the flagged pairs re-measured at Q(lambda)
   VecX distances;
 
-  double min_distance() const { return distances.size() == 0 ? INFINITY : distances.minCoeff(); }
+  double min_distance() const {
+    return distances.size() == 0 ? std::numeric_limits<double>::infinity() : distances.minCoeff();
+  }
 };
 
 // The shared machinery of one step: Q*, flagged pairs, D, M D lambda, Q(lambda), distances.
@@ -150,12 +154,12 @@ class ContactStep {
         fail_argument("d_try", "must be >= d_hat = " + std::to_string(problem.d_hat) + ", got " +
                                    std::to_string(d_try_));
     }
-    // Everything checked: now change state.
-    start_applications_ = mobility.applications();
-    mobility.set_configuration(problem.poses);  // M at Q_t (eq. 13)
-    trial_ = advance_all(*problem.U);           // eq. 16
+    trial_ = advance_all(*problem.U);  // eq. 16
     pairs_ = find_contact_pairs(problem.shapes, std::span<const Pose>(trial_), d_try_, problem.box);
     rebuild();
+    // Everything checked: only now touch the mobility.
+    start_applications_ = mobility.applications();
+    mobility.set_configuration(problem.poses);  // M at Q_t (eq. 13)
   }
 
   // Adds pairs (i < j) not yet flagged, measured at Q*; returns how many were new.
