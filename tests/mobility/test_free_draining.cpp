@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "stokescontact/mobility/free_draining.hpp"
+#include "mobility/mobility_checks.hpp"
 
 namespace sc = stokescontact;
 
@@ -150,18 +151,10 @@ TEST(FreeDrainingMobility, DenseMatrixIsSymmetricPositiveDefinite) {
 TEST(FreeDrainingMobility, ApplyEqualsDenseMatrixAndCountsApplications) {
   std::mt19937 rng(kSeed + 1);
   for (int dofs : {3, 6}) {
+    SCOPED_TRACE("seed " + std::to_string(kSeed + 1) + ", dofs " + std::to_string(dofs));
     sc::FreeDrainingMobility m = mixed_scene(40, dofs, rng);
     m.set_configuration(random_poses(40, 5.0, rng));
-    const sc::MatX M = m.dense_matrix();
-    EXPECT_EQ(m.applications(), 0u);  // formed directly
-    for (int k = 1; k <= 3; ++k) {
-      const sc::VecX F = random_vector(m.size(), rng);
-      EXPECT_LT((m.apply(F) - M * F).norm(), 1e-13 * (M * F).norm()) << "seed " << kSeed + 1;
-      EXPECT_EQ(m.applications(), static_cast<std::size_t>(k));
-    }
-    EXPECT_EQ(m.apply(sc::VecX::Zero(m.size())).cwiseAbs().maxCoeff(), 0.0);
-    m.reset_applications();
-    EXPECT_EQ(m.applications(), 0u);
+    mobility_checks::expect_apply_matches_dense(m, rng, 1e-13);
   }
 }
 

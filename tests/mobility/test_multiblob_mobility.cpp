@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "stokescontact/mobility/blob_models.hpp"
+#include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/multiblob_mobility.hpp"
 #include "common/test_support.hpp"
 
@@ -289,4 +290,21 @@ TEST(MultiblobMobility, MissedToleranceThrowsInsteadOfReturningAWrongVelocity) {
   EXPECT_THROW(m.apply(random_forces(24, 102)), std::runtime_error);
   EXPECT_EQ(m.last_iterations(), 2);
   EXPECT_GT(m.last_relative_residual(), 1e-14);
+}
+
+// A free-draining scene of an arbitrary shape takes its self-mobility from the shape's
+// multiblob model; for one body it must be the multiblob mobility itself, in any pose.
+TEST(MultiblobMobility, FreeDrainingFromTheSingleBodyMobilityMatchesOneBody) {
+  const sc::BlobModel model = sc::boomerang_surface_blobs(sc::broms_tornberg_boomerang(), 0.5);
+  const double eta = 0.7;
+  sc::FreeDrainingMobility free_draining(sc::single_body_mobility(model, eta), 1);
+  sc::MultiblobOptions options;
+  options.viscosity = eta;
+  sc::MultiblobMobility multiblob(model, 1, options);
+  const std::vector<sc::Pose> pose{{sc::Vec3(0.3, -1.0, 2.0),
+                                    sc::Quat(Eigen::AngleAxisd(1.1, sc::Vec3(1, -2, 0.5).normalized()))}};
+  free_draining.set_configuration(pose);
+  multiblob.set_configuration(pose);
+  const sc::MatX a = free_draining.dense_matrix(), b = multiblob.dense_matrix();
+  EXPECT_LE((a - b).norm(), 1e-10 * b.norm());
 }

@@ -14,6 +14,7 @@
 #endif
 
 #include "stokescontact/mobility/rpy_mobility.hpp"
+#include "mobility/mobility_checks.hpp"
 
 namespace sc = stokescontact;
 
@@ -162,21 +163,11 @@ TEST(RpyMobility, DenseMatrixIsSymmetricPositiveDefiniteWithOverlaps) {
 TEST(RpyMobility, ApplyEqualsDenseMatrixAndCountsApplications) {
   std::mt19937 rng(kSeed + 2);
   for (int dofs : {3, 6}) {
+    SCOPED_TRACE("seed " + std::to_string(kSeed + 2) + ", dofs " + std::to_string(dofs));
     // 300 spheres: two target blocks, the second partial; overlapping and distant pairs.
     sc::RpyMobility m(300, {0.8, 0.5}, dofs);
     m.set_configuration(random_poses(300, 8.0, rng));
-    const sc::MatX M = m.dense_matrix();
-    EXPECT_EQ(m.applications(), 0u);
-    for (int k = 1; k <= 3; ++k) {
-      const sc::VecX F = random_vector(m.size(), rng);
-      const sc::VecX U = m.apply(F), expected = M * F;
-      EXPECT_LT((U - expected).cwiseAbs().maxCoeff(), 1e-13 * expected.cwiseAbs().maxCoeff())
-          << "seed " << kSeed + 2 << ", dofs " << dofs;
-      EXPECT_EQ(m.applications(), static_cast<std::size_t>(k));
-    }
-    EXPECT_EQ(m.apply(sc::VecX::Zero(m.size())).cwiseAbs().maxCoeff(), 0.0);
-    m.reset_applications();
-    EXPECT_EQ(m.applications(), 0u);
+    mobility_checks::expect_apply_matches_dense(m, rng, 1e-13);
   }
 }
 
