@@ -130,6 +130,26 @@ TEST(Gmres, StagnationIsReportedNotHidden) {
   EXPECT_LE(relative_residual(shift, full.x, b), 1e-10);
 }
 
+// Singular A, b with a part outside its range: no x solves it. GMRES must report that and
+// never return an iterate worse than its start (a tiny pivot on the near-null direction
+// would otherwise blow the update up).
+TEST(Gmres, InconsistentSingularSystemNeverEndsWorseThanItStarts) {
+  // A full Krylov space (restart >= n) reaches the null direction: where the old update
+  // rule went wrong (true residuals up to 100 times the start's).
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    sc::VecX s = sc::VecX::LinSpaced(12, 1.0, 3.0);
+    s(0) = 0.0;
+    s(1) = seed % 3 == 0 ? 0.0 : (seed % 3 == 1 ? 1e-12 : 1e-9);  // numerically singular too
+    const sc::MatX a = with_singular_values(s, 100 + seed);
+    const sc::VecX b = random_vector(12, 200 + seed);
+    const auto op = [&](const sc::VecX& v) { return sc::VecX(a * v); };
+    const auto r = sc::gmres(op, b, {1e-12, 200, 12});
+    EXPECT_FALSE(r.converged) << "seed " << seed;
+    EXPECT_LE(r.relative_residual, 1.0) << "seed " << seed;
+    EXPECT_NEAR(r.relative_residual, relative_residual(a, r.x, b), 1e-12) << "seed " << seed;
+  }
+}
+
 TEST(Gmres, IterationLimitIsHonoured) {
   const Eigen::Index n = 100;
   sc::VecX s(n);

@@ -152,13 +152,19 @@ GmresResult gmres(Operator&& A, const VecX& b, Preconditioner&& P, const GmresOp
       double s = g(i) - H.row(i).segment(i + 1, k - i - 1).dot(y.segment(i + 1, k - i - 1));
       y(i) = H(i, i) != 0.0 ? s / H(i, i) : 0.0;
     }
+    const VecX x_cycle_start = result.x;
     result.x += detail::checked_call(P, VecX(V.leftCols(k) * y), n, "preconditioner");
-    r = b - detail::checked_call(A, result.x, n, "operator");
+    VecX r_new = b - detail::checked_call(A, result.x, n, "operator");
     ++result.operator_applications;
-    const double previous = r_norm;
+    // No progress over a whole cycle (singular or stagnating system): keep the better
+    // iterate, whose residual is known, and stop honestly. On a singular system with an
+    // inconsistent right-hand side a tiny pivot can make the update far worse than none.
+    if (!(r_new.norm() < r_norm)) {
+      result.x = x_cycle_start;
+      break;
+    }
+    r = std::move(r_new);
     r_norm = r.norm();
-    // No progress over a whole cycle (singular or stagnating system): stop honestly.
-    if (!(r_norm < previous)) break;
   }
   result.relative_residual = r_norm / b_norm;
   result.converged = r_norm <= target;
