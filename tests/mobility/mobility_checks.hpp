@@ -4,12 +4,44 @@
 
 #include <cstddef>
 #include <random>
+#include <vector>
 
+#include <Eigen/Eigenvalues>
+
+#include "stokescontact/core/pose.hpp"
 #include "stokescontact/mobility/mobility_operator.hpp"
 
 namespace mobility_checks {
 
 namespace sc = stokescontact;
+
+inline sc::Quat random_rotation(std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  return sc::Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
+}
+
+inline double min_eigenvalue(const sc::MatX& m) {
+  return Eigen::SelfAdjointEigenSolver<sc::MatX>(m, Eigen::EigenvaluesOnly).eigenvalues()(0);
+}
+
+// Centres uniform in a cube of side `box` (overlaps allowed), orientations uniform (a
+// normalised Gaussian quaternion).
+inline std::vector<sc::Pose> random_poses(std::size_t n, double box, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, box);
+  std::vector<sc::Pose> poses(n);
+  for (sc::Pose& p : poses) {
+    p.x = sc::Vec3(u(rng), u(rng), u(rng));
+    p.q = random_rotation(rng);
+  }
+  return poses;
+}
+
+inline sc::VecX random_vector(Eigen::Index n, std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  sc::VecX v(n);
+  for (Eigen::Index i = 0; i < n; ++i) v(i) = g(rng);
+  return v;
+}
 
 // apply(F) equals dense_matrix() * F to `tolerance` (max norm, relative), forming the dense
 // matrix costs no application, each apply counts one, zero force gives exactly zero, and

@@ -19,40 +19,19 @@ static_assert(sc::DenseMobilityOperator<sc::FreeDrainingMobility>);
 
 namespace {
 
+using mobility_checks::min_eigenvalue;
+using mobility_checks::random_poses;
+using mobility_checks::random_rotation;
+using mobility_checks::random_vector;
+
 constexpr double kPi = std::numbers::pi;
 constexpr unsigned kSeed = 20240611;
-
-sc::Quat random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  return sc::Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
-}
-
-std::vector<sc::Pose> random_poses(std::size_t n, double box, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(0.0, box);
-  std::vector<sc::Pose> poses(n);
-  for (sc::Pose& p : poses) {
-    p.x = sc::Vec3(u(rng), u(rng), u(rng));
-    p.q = random_rotation(rng);
-  }
-  return poses;
-}
-
-sc::VecX random_vector(Eigen::Index n, std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  sc::VecX v(n);
-  for (Eigen::Index i = 0; i < n; ++i) v(i) = g(rng);
-  return v;
-}
 
 // An SPD 6x6 with translation-rotation coupling, as a multiblob model of an irregular body gives.
 sc::Mat6 random_body_mobility(std::mt19937& rng) {
   const sc::VecX a = random_vector(36, rng);
   const sc::Mat6 A = Eigen::Map<const sc::Mat6>(a.data());
   return A * A.transpose() + 0.5 * sc::Mat6::Identity();
-}
-
-double min_eigenvalue(const sc::MatX& m) {
-  return Eigen::SelfAdjointEigenSolver<sc::MatX>(m, Eigen::EigenvaluesOnly).eigenvalues()(0);
 }
 
 // Three shapes: a sphere, a slender rod, an irregular body with coupling.

@@ -23,31 +23,13 @@ static_assert(sc::DenseMobilityOperator<sc::RpyMobility>);
 
 namespace {
 
+using mobility_checks::min_eigenvalue;
+using mobility_checks::random_poses;
+using mobility_checks::random_rotation;
+using mobility_checks::random_vector;
+
 constexpr double kPi = std::numbers::pi;
 constexpr unsigned kSeed = 31337;
-
-// Centres uniform in a cube of side `box` (overlaps allowed), random orientations.
-std::vector<sc::Pose> random_poses(std::size_t n, double box, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(0.0, box);
-  std::normal_distribution<double> g(0.0, 1.0);
-  std::vector<sc::Pose> poses(n);
-  for (sc::Pose& p : poses) {
-    p.x = sc::Vec3(u(rng), u(rng), u(rng));
-    p.q = sc::Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
-  }
-  return poses;
-}
-
-sc::VecX random_vector(Eigen::Index n, std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  sc::VecX v(n);
-  for (Eigen::Index i = 0; i < n; ++i) v(i) = g(rng);
-  return v;
-}
-
-double min_eigenvalue(const sc::MatX& m) {
-  return Eigen::SelfAdjointEigenSolver<sc::MatX>(m, Eigen::EigenvaluesOnly).eigenvalues()(0);
-}
 
 // Smallest pair distance of a configuration (to report how much it overlaps).
 double min_distance(const std::vector<sc::Pose>& poses) {
