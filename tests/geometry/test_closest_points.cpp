@@ -205,22 +205,23 @@ TEST(ClosestPoints, BoomerangBoomerangMatchesBruteForce) {
   check_random_pairs<sc::Boomerang, sc::Boomerang>(16);
 }
 
+// Runs check.template operator()<A, B>(seed0 + k) for the six shape combinations, k = 1..6.
+template <typename Check>
+void for_each_shape_pair(Check&& check, unsigned seed0) {
+  check.template operator()<sc::Sphere, sc::Sphere>(seed0 + 1);
+  check.template operator()<sc::Sphere, sc::Spherocylinder>(seed0 + 2);
+  check.template operator()<sc::Sphere, sc::Boomerang>(seed0 + 3);
+  check.template operator()<sc::Spherocylinder, sc::Spherocylinder>(seed0 + 4);
+  check.template operator()<sc::Spherocylinder, sc::Boomerang>(seed0 + 5);
+  check.template operator()<sc::Boomerang, sc::Boomerang>(seed0 + 6);
+}
+
 TEST(ClosestPoints, SwappingBodiesFlipsTheResult) {
-  check_symmetry<sc::Sphere, sc::Sphere>(21);
-  check_symmetry<sc::Sphere, sc::Spherocylinder>(22);
-  check_symmetry<sc::Sphere, sc::Boomerang>(23);
-  check_symmetry<sc::Spherocylinder, sc::Spherocylinder>(24);
-  check_symmetry<sc::Spherocylinder, sc::Boomerang>(25);
-  check_symmetry<sc::Boomerang, sc::Boomerang>(26);
+  for_each_shape_pair([]<sc::Shape A, sc::Shape B>(unsigned seed) { check_symmetry<A, B>(seed); }, 20);
 }
 
 TEST(ClosestPoints, InvariantUnderCommonRigidMotion) {
-  check_rigid_motion<sc::Sphere, sc::Sphere>(31);
-  check_rigid_motion<sc::Sphere, sc::Spherocylinder>(32);
-  check_rigid_motion<sc::Sphere, sc::Boomerang>(33);
-  check_rigid_motion<sc::Spherocylinder, sc::Spherocylinder>(34);
-  check_rigid_motion<sc::Spherocylinder, sc::Boomerang>(35);
-  check_rigid_motion<sc::Boomerang, sc::Boomerang>(36);
+  for_each_shape_pair([]<sc::Shape A, sc::Shape B>(unsigned seed) { check_rigid_motion<A, B>(seed); }, 30);
 }
 
 TEST(ClosestPoints, SpheresInClosedForm) {
