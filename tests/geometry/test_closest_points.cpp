@@ -141,15 +141,25 @@ void check_random_pairs(unsigned seed) {
   }
 }
 
-// Swapping the bodies: same distance, flipped normal, swapped points.
-template <sc::Shape A, sc::Shape B>
-void check_symmetry(unsigned seed) {
+// Calls check(a, pa, b, pb, i, rng) on random pairs of shapes A, B (all three kinds of
+// random_pair in turn), seeded with `seed`.
+template <sc::Shape A, sc::Shape B, typename Check>
+void for_random_pairs(unsigned seed, Check&& check) {
   Rng rng(seed);
   for (int i = 0; i < brute_force::random_pairs(10000); ++i) {
     A a;
     B b;
     Pose pa, pb;
     random_pair(rng, i % 3, a, pa, b, pb);
+    check(a, pa, b, pb, i, rng);
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+}
+
+// Swapping the bodies: same distance, flipped normal, swapped points.
+template <sc::Shape A, sc::Shape B>
+void check_symmetry(unsigned seed) {
+  for_random_pairs<A, B>(seed, [](const A& a, const Pose& pa, const B& b, const Pose& pb, int i, Rng&) {
     const sc::ClosestPoints ab = sc::closest_points(a, pa, b, pb);
     const sc::ClosestPoints ba = sc::closest_points(b, pb, a, pa);
     ASSERT_NEAR(ab.distance, ba.distance, 1e-11) << "pair " << i;
@@ -159,18 +169,13 @@ void check_symmetry(unsigned seed) {
       ASSERT_LE((ab.point_a - ba.point_b).norm(), 1e-10) << "pair " << i;
       ASSERT_LE((ab.point_b - ba.point_a).norm(), 1e-10) << "pair " << i;
     }
-  }
+  });
 }
 
 // A common rigid motion of both bodies moves the answer with them.
 template <sc::Shape A, sc::Shape B>
 void check_rigid_motion(unsigned seed) {
-  Rng rng(seed);
-  for (int i = 0; i < brute_force::random_pairs(10000); ++i) {
-    A a;
-    B b;
-    Pose pa, pb;
-    random_pair(rng, i % 3, a, pa, b, pb);
+  for_random_pairs<A, B>(seed, [](const A& a, const Pose& pa, const B& b, const Pose& pb, int i, Rng& rng) {
     const Pose g = random_pose(rng, 10.0);
     const Pose ga{g.to_world(pa.x), (g.q * pa.q).normalized()};
     const Pose gb{g.to_world(pb.x), (g.q * pb.q).normalized()};
@@ -181,7 +186,7 @@ void check_rigid_motion(unsigned seed) {
       ASSERT_LE((g.q * before.normal - after.normal).norm(), 1e-8) << "pair " << i;
       ASSERT_LE((g.to_world(before.point_a) - after.point_a).norm(), 1e-8) << "pair " << i;
     }
-  }
+  });
 }
 
 }  // namespace
