@@ -8,9 +8,9 @@
 // A solver then looks for contact magnitudes lambda >= 0 so that the corrected configuration
 //     Q(lambda) = Q_t + dt Psi (U + M D lambda)        (eq. 13, M at Q_t)
 // keeps every pair at d >= d_hat. Two cost modes for M D lambda:
-//   formed:      the Nc columns M D are computed once (Nc applications, on first need; a
-//                pair added by the guarantee loop costs one more);
-//                every M D lambda and (M D)^T v is then free;
+//   formed:      each column of M D is computed once, on first need (one application each:
+//                M D lambda needs the columns with lambda_k != 0, (M D)^T v all Nc of them);
+//                every product is then free;
 //   matrix_free: one application per distinct M D lambda and per D^T M v.
 // lambda = 0 costs nothing in both modes, so a step without contacts costs 0 applications.
 //
@@ -176,18 +176,23 @@ class ContactStep {
     return added;
   }
 
-  // M D lambda: free for lambda = 0 and in formed mode (after forming), else one application.
+  // M D lambda: free for lambda = 0 and for formed columns, else one application.
   VecX MD_times(const VecX& lambda) {
     if (lambda.isZero(0.0)) return VecX::Zero(mobility_.size());
-    if (options_.cost == MobilityCost::formed) return formed_MD() * lambda;
-    return mobility_.apply(VecX(D_ * lambda));
+    if (options_.cost == MobilityCost::matrix_free) return mobility_.apply(VecX(D_ * lambda));
+    VecX out = VecX::Zero(mobility_.size());
+    for (Eigen::Index k = 0; k < lambda.size(); ++k)
+      if (lambda(k) != 0.0) out += lambda(k) * formed_column(k);
+    return out;
   }
 
-  // (M D)^T v = D^T M v (M symmetric): free in formed mode, else one application.
+  // (M D)^T v = D^T M v (M symmetric): free once formed, else one application.
   VecX MD_transpose_times(const VecX& v) {
     if (v.isZero(0.0)) return VecX::Zero(nc());
-    if (options_.cost == MobilityCost::formed) return formed_MD().transpose() * v;
-    return D_.transpose() * mobility_.apply(v);
+    if (options_.cost == MobilityCost::matrix_free) return D_.transpose() * mobility_.apply(v);
+    VecX out(nc());
+    for (Eigen::Index k = 0; k < nc(); ++k) out(k) = formed_column(k).dot(v);
+    return out;
   }
 
   // A x = dt D^T M D x, the LCP matrix about Q* (eq. 26 with d^P): one application, or free when formed.
@@ -248,14 +253,12 @@ class ContactStep {
     last_.reset();
   }
 
-  // M D, forming only the columns not yet formed (one application each).
-  const MatX& formed_MD() {
-    const Eigen::Index formed = MD_.cols();
-    if (formed < nc()) {
-      MD_.conservativeResize(mobility_.size(), nc());
-      for (Eigen::Index k = formed; k < nc(); ++k) MD_.col(k) = mobility_.apply(VecX(D_.col(k)));
-    }
-    return MD_;
+  // Column k of M D, formed on first need (one application).
+  const VecX& formed_column(Eigen::Index k) {
+    if (MD_columns_.size() < pairs_.size()) MD_columns_.resize(pairs_.size());
+    VecX& column = MD_columns_[static_cast<std::size_t>(k)];
+    if (column.size() == 0) column = mobility_.apply(VecX(D_.col(k)));
+    return column;
   }
 
   ContactStepProblem<S> problem_;
@@ -267,7 +270,7 @@ class ContactStep {
   std::vector<Pose> trial_;  // Q*
   std::vector<ContactPair> pairs_;
   Eigen::SparseMatrix<double> D_;
-  MatX MD_;  // the columns of M D formed so far
+  std::vector<VecX> MD_columns_;  // the columns of M D formed so far (empty: not yet)
   std::optional<ContactEvaluation> last_;
 };
 

@@ -1,0 +1,173 @@
+#pragma once
+// The default contact solver: the complementarity problem of eq. 27,
+//     0 <= lambda  _|_  d(lambda) - d_hat (1 + margin) >= 0,   d = d^P(Q(lambda)),
+// solved by defect correction with a probed Delassus matrix. Its solution is also the one of
+// the barrier method (eq. 15): no pair below d_hat, and a force only on pairs held at the
+// threshold, so no force larger than needed.
+//
+// Why it is cheap. Of the Nc pairs flagged by d_try, only the few that the trial step brings
+// below d_hat need a force (in the Fig. 4 scenes ~4% of them), and those are spread through the
+// suspension. We keep a working set W of those pairs (and of any pair a correction brings below
+// the threshold) and approximate A = dt D^T M D on W by probing (delassus_probing.hpp):
+// contacts far apart share one mobility application. Each iteration then solves the LCP of the
+// linear model about the current iterate on W, a small dense problem (minimum-map Newton, no
+// mobility applications),
+//     0 <= lambda_W  _|_  d_W(lambda_k) + A~ (lambda_W - lambda_k,W) - d_hat (1 + margin) >= 0,
+// and measures the true distances at the new lambda: one application for M D lambda. The true
+// d(lambda_k) enters every model, so a fixed point solves eq. 27 exactly whatever A~ is; the
+// probing error (far-field coupling, a few per cent) sets the contraction rate per iteration.
+// For spheres the linear model underestimates each centre distance (it is convex in the
+// displacements), which keeps the iterates on the separated side.
+//
+// Stopping rule (eq. 29 form): at an iterate whose flagged pairs all have d >= d_hat, stop when
+// the next correction would change lambda by less than tol ||lambda||_inf; that iterate is
+// returned, so separation is measured, never predicted. The margin puts roundoff and the
+// remaining probing error on the separated side; it costs a relative force excess of about
+// margin d_hat / (the overlap the force removes).
+//
+// Cost: the probes (one per colour of each batch of new working-set pairs) plus one
+// application per iteration; 0 when no pair comes below d_hat. In formed mode every probe is
+// one exact column of M D (cached by the step), A~ = A, and the iterations are free.
+// Iterations reported: corrections (LCPs solved).
+#include <algorithm>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "stokescontact/contact/contact_step.hpp"
+#include "stokescontact/contact/delassus_probing.hpp"
+#include "stokescontact/contact/lcp_minimum_map_newton.hpp"
+#include "stokescontact/contact/secant_update.hpp"
+
+namespace stokescontact {
+
+struct DefaultSolverOptions {
+  double margin = 1e-4;               // target d_hat (1 + margin)
+  double tol = 1e-4;                  // eq. 29 rule on successive corrections
+  double probe_radius_factor = 4.0;   // probe radius = factor x the largest bounding radius
+  int max_iterations = 50;            // corrections per round
+  LcpOptions lcp{1e-12};              // each small LCP's stopping rule
+
+  void validate() const {
+    require_non_negative(margin, "DefaultSolverOptions.margin");
+    require_positive(tol, "DefaultSolverOptions.tol");
+    require_positive(probe_radius_factor, "DefaultSolverOptions.probe_radius_factor");
+    if (max_iterations < 1)
+      fail_argument("DefaultSolverOptions.max_iterations", "must be >= 1, got " + std::to_string(max_iterations));
+    lcp.validate();
+  }
+};
+
+namespace detail {
+
+template <Shape S>
+double largest_bounding_radius(std::span<const S> shapes) {
+  double r = 0.0;
+  for (const S& s : shapes) r = std::max(r, bounding_radius(s));
+  return r;
+}
+
+// The working set's LCP of the linear model about the current iterate (A: the model's matrix
+// on W, distances: all flagged pairs at the iterate); the new lambda on all pairs, none if the
+// LCP solver did not converge.
+inline std::optional<VecX> solve_working_set_lcp(const MatX& A, std::span<const Eigen::Index> W, const VecX& lambda,
+                                  const VecX& distances, double target, const LcpOptions& options) {
+  const auto n = static_cast<Eigen::Index>(W.size());
+  VecX lambda_W(n), d_W(n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    lambda_W(r) = lambda(W[static_cast<std::size_t>(r)]);
+    d_W(r) = distances(W[static_cast<std::size_t>(r)]);
+  }
+  const VecX b = d_W - VecX::Constant(n, target) - A * lambda_W;
+  const LcpResult lcp = solve_lcp_minimum_map_newton(A, b, options, &lambda_W);
+  if (!lcp.converged) return std::nullopt;
+  VecX next = VecX::Zero(lambda.size());
+  for (Eigen::Index r = 0; r < n; ++r) next(W[static_cast<std::size_t>(r)]) = lcp.gamma(r);
+  return next;
+}
+
+// One round from the warm start (the previous round's lambda, zero-padded).
+template <Shape S, MobilityOperator M>
+ContactSolveOutcome solve_default_round(ContactStep<S, M>& step, VecX lambda, const DefaultSolverOptions& options) {
+  ContactSolveOutcome out;
+  const double d_hat = step.problem().d_hat, target = d_hat * (1.0 + options.margin);
+  const double radius = step.options().cost == MobilityCost::formed
+                            ? std::numeric_limits<double>::infinity()
+                            : options.probe_radius_factor * largest_bounding_radius(step.problem().shapes);
+  DelassusProbing probing(step, radius);
+  SecantCorrection secant;
+  std::vector<char> member(static_cast<std::size_t>(step.nc()), 0);
+  const auto join = [&](std::vector<Eigen::Index>& joining, Eigen::Index k) {
+    if (member[static_cast<std::size_t>(k)]) return;
+    member[static_cast<std::size_t>(k)] = 1;
+    joining.push_back(k);
+  };
+  VecX previous_lambda, previous_distances;
+  for (;;) {
+    const ContactEvaluation& e = step.evaluate(lambda);
+    // The working set: every pair below the target or pushed...
+    std::vector<Eigen::Index> joining;
+    for (Eigen::Index k = 0; k < step.nc(); ++k)
+      if (e.distances(k) < target || lambda(k) > 0.0) join(joining, k);
+    if (previous_lambda.size() > 0 && out.iterations > 1)  // the first step is far from linear
+      secant.add(lambda - previous_lambda, e.distances - previous_distances);
+    VecX next;
+    for (;;) {
+      probing.add(step, joining);
+      const std::vector<Eigen::Index>& W = probing.members();
+      // The secant-corrected model is not symmetric; should its LCP fail, the probed one is.
+      std::optional<VecX> solved =
+          solve_working_set_lcp(secant.corrected(probing.matrix(), W), W, lambda, e.distances, target, options.lcp);
+      if (!solved) solved = solve_working_set_lcp(probing.matrix(), W, lambda, e.distances, target, options.lcp);
+      if (!solved) {
+        out.message = "default solver: the working-set LCP (" + std::to_string(W.size()) + " pairs) did not converge";
+        out.lambda = std::move(lambda);
+        return out;
+      }
+      next = std::move(*solved);
+      // ... and every pair the model predicts the new lambda brings below it (free: the probes
+      // already hold those rows).
+      joining.clear();
+      VecX change_W(static_cast<Eigen::Index>(W.size()));
+      for (std::size_t r = 0; r < W.size(); ++r) change_W(static_cast<Eigen::Index>(r)) = next(W[r]) - lambda(W[r]);
+      for (Eigen::Index k = 0; k < step.nc(); ++k)
+        if (!member[static_cast<std::size_t>(k)] && e.distances(k) + probing.row(k).dot(change_W) < target)
+          join(joining, k);
+      if (joining.empty()) break;
+    }
+    const double change = (next - lambda).lpNorm<Eigen::Infinity>();
+    const double scale = std::max(next.lpNorm<Eigen::Infinity>(), lambda.lpNorm<Eigen::Infinity>());
+    if (e.min_distance() >= d_hat && change <= options.tol * scale) {  // eq. 29 at a separated iterate
+      out.converged = true;
+      break;
+    }
+    if (out.iterations == options.max_iterations) {
+      out.message = "default solver: " + std::to_string(out.iterations) + " corrections, min flagged d / d_hat = " +
+                    std::to_string(e.min_distance() / d_hat) + ", last change " + std::to_string(change / scale) +
+                    " of ||lambda||_inf";
+      break;
+    }
+    ++out.iterations;
+    previous_lambda = lambda;
+    previous_distances = e.distances;
+    lambda = std::move(next);
+  }
+  out.lambda = std::move(lambda);
+  return out;
+}
+
+}  // namespace detail
+
+template <Shape S, MobilityOperator M>
+ContactStepResult solve_contact_step_default(const ContactStepProblem<S>& problem, M& mobility,
+                                             const ContactStepOptions& options = {},
+                                             const DefaultSolverOptions& solver = {}) {
+  solver.validate();
+  return run_contact_step(problem, mobility, options, [&solver](ContactStep<S, M>& step, const VecX& warm) {
+    return detail::solve_default_round(step, warm, solver);
+  });
+}
+
+}  // namespace stokescontact
