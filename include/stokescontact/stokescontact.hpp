@@ -54,5 +54,9 @@
 #include "stokescontact/contact/solver_lcp_sequence.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
 
+// dynamics
+#include "stokescontact/dynamics/background_flow.hpp"
+#include "stokescontact/dynamics/time_stepper.hpp"
+
 // io
 #include "stokescontact/io/json.hpp"

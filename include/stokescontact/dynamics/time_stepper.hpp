@@ -1,0 +1,265 @@
+#pragma once
+// Forward Euler with contact correction (Broms & Tornberg Sec. 2, 3.2.3). One step from Q_t:
+//   1. U = U_bg(Q_t) + M(Q_t) F_ext(t, Q_t)             (eq. 3, no Brownian term): one mobility
+//      application, skipped when F_ext = 0;
+//   2. a contact step by the user's solver from Q_t with U: the trial step Q* = Q_t + dt Psi U
+//      (eq. 16), then lambda >= 0 and Q_{t+dt} = Q_t + dt Psi (U + M D lambda)  (eq. 13);
+//   3. Q_{t+dt} = the solver's poses, centres wrapped back into [0, L)^3 in a periodic box
+//      (positions only: the contact code measures pairs by minimum image).
+// A background flow with a periodic box is refused: u = E x is not periodic, and
+// Lees-Edwards boundary conditions are not implemented.
+//
+// Failures are not hidden: a contact step that reports failed_separation makes step() throw
+// std::runtime_error with the solver's message, and the state stays at Q_t. Bad input throws
+// std::invalid_argument naming the field before anything changes.
+#include <chrono>
+#include <cstdio>
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "stokescontact/contact/contact_step.hpp"
+#include "stokescontact/dynamics/background_flow.hpp"
+#include "stokescontact/io/json.hpp"
+
+namespace stokescontact {
+
+struct TimeStepperOptions {
+  double dt = 0.0;                   // > 0
+  double d_hat = 0.0;                // > 0
+  double d_try = 0.0;                // 0: eq. 30/31 per step (ContactStepProblem.d_try)
+  double d_try_multiplier = 1.0;     // >= 1
+  std::optional<PeriodicBox> box;    // none for open space
+  std::optional<LinearBackgroundFlow> background_flow;  // none: fluid at rest
+
+  void validate() const {
+    require_positive(dt, "dt");
+    require_positive(d_hat, "d_hat");
+    require_non_negative(d_try, "d_try");
+    if (d_try > 0.0 && !(d_try >= d_hat))
+      fail_argument("d_try", "must be 0 (eq. 30/31) or >= d_hat = " + std::to_string(d_hat) + ", got " +
+                                 std::to_string(d_try));
+    require_finite(d_try_multiplier, "d_try_multiplier");
+    if (!(d_try_multiplier >= 1.0))
+      fail_argument("d_try_multiplier", "must be >= 1, got " + std::to_string(d_try_multiplier));
+    if (box) {
+      for (int k = 0; k < 3; ++k) require_positive(box->lengths[k], "box.lengths");
+      if (background_flow && !background_flow->is_zero())
+        fail_argument("background_flow",
+                      "is not allowed with a periodic box (u = E x is not periodic; no Lees-Edwards conditions)");
+    }
+  }
+};
+
+// What one step did: the numbers the papers report per step.
+struct StepDiagnostics {
+  long step = 0;                       // 1 for the first step
+  double time = 0.0;                   // t + dt, the time reached
+  std::size_t flagged_pairs = 0;       // Nc at the trial step (and pairs the guarantee loop added)
+  std::size_t active_pairs = 0;        // pairs with lambda > 0
+  double min_distance_ratio = 0.0;     // min d^P over all pairs of Q_{t+dt} / d_hat (inf: < 2 bodies)
+  ContactStepStatus status = ContactStepStatus::converged;
+  std::string message;                 // the solver's message (empty when it has nothing to say)
+  int iterations = 0;                  // the contact solver's iterations
+  std::size_t unconstrained_applications = 0;  // 1 for M F_ext, 0 when F_ext = 0
+  std::size_t mobility_applications = 0;       // all of the step: the one for U plus the contact step's
+  double wall_time_s = 0.0;            // the whole step
+  double lambda_sum = 0.0;
+  double lambda_max = 0.0;
+};
+
+namespace detail {
+
+inline const char* contact_status_name(ContactStepStatus s) {
+  switch (s) {
+    case ContactStepStatus::converged: return "converged";
+    case ContactStepStatus::not_converged: return "not_converged";
+    case ContactStepStatus::failed_separation: return "failed_separation";
+  }
+  return "unknown";
+}
+
+// A JSON string literal: quotes, backslashes and control characters escaped.
+inline std::string json_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace detail
+
+// One line of JSON (no newline); min_distance_ratio is null when infinite (fewer than 2 bodies).
+inline std::string to_json(const StepDiagnostics& d) {
+  return "{\"step\": " + std::to_string(d.step) + ", \"time\": " + json_number(d.time) +
+         ", \"flagged_pairs\": " + std::to_string(d.flagged_pairs) +
+         ", \"active_pairs\": " + std::to_string(d.active_pairs) +
+         ", \"min_distance_ratio\": " + json_number(d.min_distance_ratio) + ", \"status\": " +
+         detail::json_quoted(detail::contact_status_name(d.status)) + ", \"message\": " + detail::json_quoted(d.message) +
+         ", \"iterations\": " + std::to_string(d.iterations) +
+         ", \"unconstrained_applications\": " + std::to_string(d.unconstrained_applications) +
+         ", \"mobility_applications\": " + std::to_string(d.mobility_applications) +
+         ", \"wall_time_s\": " + json_number(d.wall_time_s) + ", \"lambda_sum\": " + json_number(d.lambda_sum) +
+         ", \"lambda_max\": " + json_number(d.lambda_max) + "}";
+}
+
+// External forces (and torques) per body, stacked as the mobility's rows, at time t and poses Q_t.
+using ExternalForceField = std::function<VecX(double, std::span<const Pose>)>;
+
+template <Shape S, MobilityOperator M>
+class TimeStepper {
+ public:
+  // Any of the library's solvers fits through a lambda, e.g.
+  //   [](const ContactStepProblem<S>& p, M& m) { return solve_contact_step_lcp_sequence(p, m); }
+  using ContactSolver = std::function<ContactStepResult(const ContactStepProblem<S>&, M&)>;
+
+  // `shapes`: one per body or one shared; `mobility` is referenced and must outlive the
+  // stepper. Q_0 must be contact free (every d^P >= 0). Centres are wrapped into the box.
+  TimeStepper(std::vector<S> shapes, std::vector<Pose> poses, M& mobility, ContactSolver contact_solver,
+              TimeStepperOptions options, double t0 = 0.0)
+      : shapes_(std::move(shapes)), poses_(std::move(poses)), mobility_(mobility),
+        solver_(std::move(contact_solver)), options_(std::move(options)), time_(t0), start_time_(t0) {
+    options_.validate();
+    require_finite(t0, "t0");
+    if (!solver_) fail_argument("contact_solver", "must be given");
+    validate_scene(std::span<const S>(shapes_), std::span<const Pose>(poses_));
+    dofs_ = mobility_.dofs_per_body();
+    if (dofs_ != 3 && dofs_ != 6) fail_argument("mobility", "dofs_per_body must be 3 or 6, got " + std::to_string(dofs_));
+    if (mobility_.size() != size())
+      fail_argument("mobility", "has size " + std::to_string(mobility_.size()) + ", expected " +
+                                    std::to_string(size()) + " (bodies * dofs_per_body)");
+    const MinimumDistance start =
+        minimum_pair_distance(std::span<const S>(shapes_), std::span<const Pose>(poses_), options_.box);
+    if (start.distance < 0.0)
+      fail_argument("poses", "Q_0 must be contact free; bodies " + std::to_string(start.i) + " and " +
+                                 std::to_string(start.j) + " overlap, d = " + std::to_string(start.distance));
+    wrap_into_box();
+  }
+
+  // Constant external forces: size bodies * dofs_per_body, finite. Zero by default.
+  void set_external_forces(VecX forces) {
+    require_finite(forces, size(), "external_forces");
+    forces_ = std::move(forces);
+    force_field_ = nullptr;
+  }
+
+  // Forces depending on (t, Q_t), checked at each step (size, finite) before anything changes.
+  void set_external_force_field(ExternalForceField field) {
+    if (!field) fail_argument("external_forces", "the force field must be callable");
+    force_field_ = std::move(field);
+    forces_.reset();
+  }
+
+  // One JSON object per step is written here (nullptr: none); the stream must outlive its use.
+  void set_diagnostics_output(std::ostream* out) { json_out_ = out; }
+
+  // One step; returns its diagnostics (also kept in diagnostics()). Throws std::runtime_error
+  // on failed separation.
+  StepDiagnostics step() {
+    const auto start = std::chrono::steady_clock::now();
+    const std::span<const Pose> q_t(poses_);
+    // Eq. 3: U = U_bg + M F_ext.
+    std::optional<VecX> forces;
+    if (force_field_) {
+      VecX f = force_field_(time_, q_t);
+      require_finite(f, size(), "external_forces");
+      forces = std::move(f);
+    } else if (forces_) {
+      forces = *forces_;
+    }
+    VecX U = options_.background_flow ? options_.background_flow->body_velocities(q_t, dofs_) : VecX::Zero(size());
+    std::size_t applications = 0;
+    if (forces && !forces->isZero(0.0)) {
+      mobility_.set_configuration(q_t);
+      U += mobility_.apply(*forces);
+      applications = 1;
+    }
+    // Eq. 13/16 through the user's solver.
+    const ContactStepProblem<S> problem{std::span<const S>(shapes_), q_t,     &U, options_.dt, options_.d_hat,
+                                        options_.d_try,              options_.d_try_multiplier, options_.box};
+    ContactStepResult result = solver_(problem, mobility_);
+    if (result.status == ContactStepStatus::failed_separation)
+      throw std::runtime_error("time step " + std::to_string(steps_ + 1) + " from t = " + std::to_string(time_) +
+                               ": " + result.message);
+    if (result.poses.size() != poses_.size())
+      throw std::runtime_error("contact solver returned " + std::to_string(result.poses.size()) + " poses for " +
+                               std::to_string(poses_.size()) + " bodies");
+    // Commit Q_{t+dt}.
+    poses_ = std::move(result.poses);
+    wrap_into_box();
+    ++steps_;
+    time_ = t0_plus_steps();
+    StepDiagnostics d;
+    d.step = steps_;
+    d.time = time_;
+    d.flagged_pairs = result.flagged_pairs;
+    for (Eigen::Index k = 0; k < result.lambda.size(); ++k) d.active_pairs += result.lambda(k) > 0.0 ? 1 : 0;
+    d.min_distance_ratio = result.min_distance_ratio;  // minimum image in a box: wrapping changes nothing
+    d.status = result.status;
+    d.message = std::move(result.message);
+    d.iterations = result.iterations;
+    d.unconstrained_applications = applications;
+    d.mobility_applications = applications + result.mobility_applications;
+    d.lambda_sum = result.lambda_sum;
+    d.lambda_max = result.lambda_max;
+    d.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    diagnostics_.push_back(std::move(d));
+    if (json_out_ != nullptr) *json_out_ << to_json(diagnostics_.back()) << '\n';
+    return diagnostics_.back();
+  }
+
+  // `steps` steps (>= 0); stops at the first throw, the state then at the last good step.
+  void run(int steps) {
+    if (steps < 0) fail_argument("steps", "must be >= 0, got " + std::to_string(steps));
+    for (int k = 0; k < steps; ++k) step();
+  }
+
+  const std::vector<Pose>& poses() const { return poses_; }
+  const std::vector<S>& shapes() const { return shapes_; }
+  double time() const { return time_; }
+  long steps_taken() const { return steps_; }
+  const std::vector<StepDiagnostics>& diagnostics() const { return diagnostics_; }
+  const TimeStepperOptions& options() const { return options_; }
+  Eigen::Index size() const { return static_cast<Eigen::Index>(poses_.size()) * dofs_; }
+
+ private:
+  // t_n = t_0 + n dt, not a running sum: no drift over many steps.
+  double t0_plus_steps() const { return start_time_ + static_cast<double>(steps_) * options_.dt; }
+
+  void wrap_into_box() {
+    if (!options_.box) return;
+    for (Pose& p : poses_) p.x = stokescontact::wrap_into_box(p.x, *options_.box);
+  }
+
+  std::vector<S> shapes_;
+  std::vector<Pose> poses_;
+  M& mobility_;
+  ContactSolver solver_;
+  TimeStepperOptions options_;
+  double time_ = 0.0;
+  double start_time_ = 0.0;
+  int dofs_ = 6;
+  long steps_ = 0;
+  std::optional<VecX> forces_;
+  ExternalForceField force_field_;
+  std::ostream* json_out_ = nullptr;
+  std::vector<StepDiagnostics> diagnostics_;
+};
+
+}  // namespace stokescontact

@@ -1,0 +1,437 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/test_support.hpp"
+#include "stokescontact/contact/solver_barrier_nlopt.hpp"
+#include "stokescontact/contact/solver_lcp_sequence.hpp"
+#include "stokescontact/dynamics/background_flow.hpp"
+#include "stokescontact/dynamics/time_stepper.hpp"
+#include "stokescontact/mobility/free_draining.hpp"
+
+namespace sc = stokescontact;
+
+namespace {
+
+using test_support::expect_rejects;
+using test_support::random_rotation;
+using test_support::random_unit_vector;
+using test_support::uniform;
+using test_support::uniform_vector;
+
+using SphereStepper = sc::TimeStepper<sc::Sphere, sc::FreeDrainingMobility>;
+using SphereSolver = SphereStepper::ContactSolver;
+
+// Unit spheres in viscosity 1: translational mobility mu = 1 / (6 pi).
+constexpr double kMu = 1.0 / (6.0 * std::numbers::pi);
+constexpr double kMargin = 1e-3;  // ContactStepOptions::separation_margin
+
+const auto kLcpSequence = [](const auto& problem, auto& mobility) {
+  return sc::solve_contact_step_lcp_sequence(problem, mobility);
+};
+const auto kBarrierSlsqp = [](const auto& problem, auto& mobility) {
+  return sc::solve_contact_step_barrier(problem, mobility);
+};
+
+sc::FreeDrainingMobility sphere_mobility(std::size_t n, int dofs) {
+  return sc::FreeDrainingMobility(sc::sphere_mobility(sc::Sphere{1.0}, 1.0), n, dofs);
+}
+
+sc::TimeStepperOptions options(double dt, double d_hat) {
+  sc::TimeStepperOptions o;
+  o.dt = dt;
+  o.d_hat = d_hat;
+  return o;
+}
+
+// Smallest surface distance between unit spheres by brute force, minimum image in a cubic box of side L (0: open).
+double brute_force_min_distance(const std::vector<sc::Pose>& poses, double L = 0.0) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (std::size_t j = i + 1; j < poses.size(); ++j) {
+      sc::Vec3 d = poses[j].x - poses[i].x;
+      if (L > 0.0)
+        for (int k = 0; k < 3; ++k) d[k] -= L * std::round(d[k] / L);
+      best = std::min(best, d.norm() - 2.0);
+    }
+  return best;
+}
+
+// Forward Euler in shear by hand: x += dt rate y; rotation by -rate dt / 2 about z per step.
+TEST(TimeStepper, FreeBodiesInShearMoveExactlyWithTheFlow) {
+  const double rate = 0.8, dt = 0.05;
+  const int steps = 40;
+  test_support::Rng rng(21);
+  const std::vector<sc::Pose> start = {{sc::Vec3(0.2, 1.5, 0.1), random_rotation(rng)},
+                                       {sc::Vec3(3.0, -2.0, 10.0), random_rotation(rng)}};
+  for (const int dofs : {3, 6}) {
+    SCOPED_TRACE(dofs);
+    auto mobility = sphere_mobility(2, dofs);
+    sc::TimeStepperOptions o = options(dt, 0.01);
+    o.background_flow = sc::LinearBackgroundFlow::shear(rate);
+    SphereStepper stepper({sc::Sphere{1.0}}, start, mobility, kLcpSequence, o);
+    std::vector<sc::Vec3> x = {start[0].x, start[1].x};
+    for (int n = 1; n <= steps; ++n) {
+      const sc::StepDiagnostics& d = stepper.step();
+      EXPECT_EQ(d.step, n);
+      EXPECT_DOUBLE_EQ(d.time, n * dt);
+      EXPECT_EQ(d.flagged_pairs, 0u);
+      EXPECT_EQ(d.mobility_applications, 0u);  // F_ext = 0: no mobility solve at all
+      for (std::size_t b = 0; b < 2; ++b) {
+        x[b].x() += dt * rate * x[b].y();
+        EXPECT_LE((stepper.poses()[b].x - x[b]).norm(), 1e-12) << "step " << n << " body " << b;
+        const sc::Mat3 expected =
+            dofs == 6 ? sc::Mat3(Eigen::AngleAxisd(-0.5 * rate * n * dt, sc::Vec3::UnitZ()) * start[b].q)
+                      : start[b].rotation();
+        EXPECT_LE((stepper.poses()[b].rotation() - expected).norm(), 1e-12) << "step " << n << " body " << b;
+      }
+    }
+    // Closed form of the recursion: y is constant, so x_n = x_0 + n dt rate y_0.
+    for (std::size_t b = 0; b < 2; ++b)
+      EXPECT_NEAR(stepper.poses()[b].x.x(), start[b].x.x() + steps * dt * rate * start[b].x.y(), 1e-12);
+    EXPECT_EQ(mobility.applications(), 0u);
+  }
+}
+
+// U = U_bg + M F: a sphere in shear under a constant force, integrated by hand.
+TEST(TimeStepper, ForcesAndBackgroundFlowAdd) {
+  const double rate = -1.3, dt = 0.02;
+  const sc::Vec3 f(2.0, -3.0, 0.5);
+  auto mobility = sphere_mobility(1, 6);
+  sc::TimeStepperOptions o = options(dt, 0.01);
+  o.background_flow = sc::LinearBackgroundFlow::shear(rate);
+  SphereStepper stepper({sc::Sphere{1.0}}, {sc::Pose{sc::Vec3(1, 2, 3), sc::Quat::Identity()}}, mobility,
+                        kLcpSequence, o);
+  sc::VecX F = sc::VecX::Zero(6);
+  F.head<3>() = f;
+  F(5) = 4.0;  // torque about z
+  stepper.set_external_forces(F);
+  sc::Vec3 x(1, 2, 3);
+  const double omega_z = -0.5 * rate + 4.0 / (8.0 * std::numbers::pi);
+  for (int n = 1; n <= 25; ++n) {
+    const sc::StepDiagnostics& d = stepper.step();
+    EXPECT_EQ(d.unconstrained_applications, 1u);
+    EXPECT_EQ(d.mobility_applications, 1u);
+    x += dt * (sc::Vec3(rate * x.y(), 0, 0) + kMu * f);
+    EXPECT_LE((stepper.poses()[0].x - x).norm(), 1e-12) << "step " << n;
+    const sc::Mat3 expected(Eigen::AngleAxisd(omega_z * n * dt, sc::Vec3::UnitZ()));
+    EXPECT_LE((stepper.poses()[0].rotation() - expected).norm(), 1e-12) << "step " << n;
+    EXPECT_TRUE(std::isinf(d.min_distance_ratio));  // one body: no pairs
+  }
+  EXPECT_EQ(mobility.applications(), 25u);
+}
+
+// Two spheres pushed together by f = 6 pi (speed 1 each): they close the gap, then sit at
+// d_hat, the contact force balancing f (lambda = f once they rest there).
+TEST(TimeStepper, TwoSpheresDrivenHeadOnSettleAtDHat) {
+  const double dt = 0.01, d_hat = 0.01, f = 1.0 / kMu;
+  const std::vector<std::pair<std::string, SphereSolver>> solvers = {{"lcp_sequence", kLcpSequence},
+                                                                       {"barrier_slsqp", kBarrierSlsqp}};
+  for (const auto& [name, solver] : solvers) {
+    SCOPED_TRACE(name);
+    auto mobility = sphere_mobility(2, 3);
+    SphereStepper stepper({sc::Sphere{1.0}},
+                          {sc::Pose{sc::Vec3(0, 0, 0), sc::Quat::Identity()},
+                           sc::Pose{sc::Vec3(2.5, 0, 0), sc::Quat::Identity()}},
+                          mobility, solver, options(dt, d_hat));
+    sc::VecX F(6);
+    F << f, 0, 0, -f, 0, 0;
+    stepper.set_external_forces(F);
+    int contact_steps = 0;
+    for (int n = 1; n <= 80; ++n) {
+      const sc::StepDiagnostics& diag = stepper.step();
+      const std::vector<sc::Pose>& p = stepper.poses();
+      const double d = (p[1].x - p[0].x).norm() - 2.0;
+      ASSERT_GE(d, d_hat * (1.0 - kMargin)) << "step " << n;
+      EXPECT_NEAR(diag.min_distance_ratio, d / d_hat, 1e-9) << "step " << n;
+      EXPECT_NEAR(p[0].x.x() + p[1].x.x(), 2.5, 1e-12) << "step " << n;  // equal and opposite forces
+      EXPECT_EQ(p[0].x.tail<2>().norm() + p[1].x.tail<2>().norm(), 0.0);
+      contact_steps += diag.active_pairs > 0 ? 1 : 0;
+    }
+    // The gap 0.5 closes at relative speed 2 in 25 steps; contact from then on.
+    EXPECT_GE(contact_steps, 50);
+    const std::vector<sc::Pose>& p = stepper.poses();
+    const double d = (p[1].x - p[0].x).norm() - 2.0;
+    const sc::StepDiagnostics& last = stepper.diagnostics().back();
+    std::printf("[head-on %s] final d / d_hat = %.12f, lambda / f = %.12f, contact steps %d\n", name.c_str(),
+                d / d_hat, last.lambda_max / f, contact_steps);
+    if (name == "lcp_sequence") {
+      EXPECT_NEAR(d, d_hat, 1e-9 * d_hat);
+      EXPECT_NEAR(last.lambda_max, f, 1e-6 * f);
+    } else {  // the barrier stops by eq. 29 (TOL = 1e-2) within the separation margin
+      EXPECT_NEAR(d, d_hat, 2e-3 * d_hat);
+      EXPECT_NEAR(last.lambda_max, f, 1e-3 * f);
+    }
+  }
+}
+
+struct CountingSolver {
+  std::size_t* last_contact_applications;
+  sc::ContactStepResult operator()(const sc::ContactStepProblem<sc::Sphere>& p, sc::FreeDrainingMobility& m) const {
+    sc::ContactStepResult r = sc::solve_contact_step_lcp_sequence(p, m);
+    *last_contact_applications = r.mobility_applications;
+    return r;
+  }
+};
+
+// Random forces each step (a field of (t, Q_t)), the cluster also pulled to its centre so that
+// it jams: the minimum distance, by brute force, stays >= d_hat (1 - margin) after every step.
+// Mobility applications per step: 1 for U plus the contact step's, as the mobility counted them.
+void run_random_sphere_scene(std::uint64_t seed, std::optional<double> box_side) {
+  SCOPED_TRACE("seed " + std::to_string(seed) + (box_side ? " periodic" : " open"));
+  test_support::Rng rng(seed);
+  const int side = 3;
+  const double spacing = 2.3, dt = 0.02, d_hat = 0.02;
+  std::vector<sc::Pose> poses;
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j)
+      for (int k = 0; k < side; ++k)
+        poses.push_back({sc::Vec3(1.2 + spacing * i, 1.2 + spacing * j, 1.2 + spacing * k) + uniform_vector(rng, -0.1, 0.1),
+                         sc::Quat::Identity()});
+  const auto n = static_cast<Eigen::Index>(poses.size());
+  auto mobility = sphere_mobility(poses.size(), 3);
+  std::size_t contact_applications = 0;
+  sc::TimeStepperOptions o = options(dt, d_hat);
+  if (box_side) o.box = sc::PeriodicBox{sc::Vec3::Constant(*box_side)};
+  SphereStepper stepper({sc::Sphere{1.0}}, poses, mobility, CountingSolver{&contact_applications}, o);
+  test_support::Rng force_rng(seed + 1);
+  const bool periodic = box_side.has_value();
+  stepper.set_external_force_field([&force_rng, n, periodic](double, std::span<const sc::Pose> q) {
+    sc::Vec3 centre = sc::Vec3::Zero();
+    for (const sc::Pose& p : q) centre += p.x / static_cast<double>(q.size());
+    sc::VecX F(3 * n);
+    for (Eigen::Index b = 0; b < n; ++b) {
+      const sc::Vec3 pull = periodic ? sc::Vec3(3.0, 0, 0) : sc::Vec3(centre - q[static_cast<std::size_t>(b)].x);
+      F.segment<3>(3 * b) = (2.0 * random_unit_vector(force_rng) + pull) / kMu;
+    }
+    return F;
+  });
+  std::size_t active = 0, wrapped = 0;
+  for (int step = 1; step <= 50; ++step) {
+    const std::vector<sc::Pose> before = stepper.poses();
+    const std::size_t applications_before = mobility.applications();
+    const sc::StepDiagnostics& d = stepper.step();
+    const double d_min = brute_force_min_distance(stepper.poses(), box_side.value_or(0.0));
+    ASSERT_GE(d_min, d_hat * (1.0 - kMargin)) << "step " << step;
+    EXPECT_NEAR(d.min_distance_ratio, d_min / d_hat, 1e-9 * std::max(1.0, d_min / d_hat)) << "step " << step;
+    EXPECT_EQ(d.status, sc::ContactStepStatus::converged) << d.message;
+    EXPECT_EQ(d.unconstrained_applications, 1u);
+    EXPECT_EQ(d.mobility_applications, 1u + contact_applications) << "step " << step;
+    EXPECT_EQ(d.mobility_applications, mobility.applications() - applications_before) << "step " << step;
+    EXPECT_LE(d.active_pairs, d.flagged_pairs);
+    active += d.active_pairs;
+    if (box_side)
+      for (std::size_t b = 0; b < before.size(); ++b) {
+        const sc::Vec3& x = stepper.poses()[b].x;
+        EXPECT_TRUE((x.array() >= 0.0).all() && (x.array() < *box_side).all()) << "body " << b;
+        wrapped += (x - before[b].x).cwiseAbs().maxCoeff() > 0.5 * *box_side ? 1 : 0;
+      }
+  }
+  EXPECT_GT(active, 20u);  // the scene did jam: the test exercised contacts
+  if (box_side) {
+    EXPECT_GT(wrapped, 0u);  // and bodies crossed the box
+  }
+  std::printf("[random spheres seed %llu %s] active contacts over 50 steps: %zu, wraps %zu\n",
+              static_cast<unsigned long long>(seed), box_side ? "periodic" : "open", active, wrapped);
+}
+
+TEST(TimeStepper, ManySpheresWithRandomForcesNeverOverlap) {
+  for (const std::uint64_t seed : {101u, 202u}) run_random_sphere_scene(seed, std::nullopt);
+}
+
+TEST(TimeStepper, ManySpheresInAPeriodicBoxNeverOverlapAndStayWrapped) {
+  run_random_sphere_scene(303u, 7.0);
+}
+
+// Rods in the yz plane squeezed by biaxial compression (the setting of Broms & Tornberg Sec.
+// 3.2.3, eq. 32), 6 dofs: no overlap at any step, and contacts did occur. The barrier method:
+// on this scene of exactly parallel rods the LCP sequence (default options) stops at step 18
+// with min d / d_hat = 0.949 after 20 LCPs, and the stepper throws (see the report of issue #4).
+TEST(TimeStepper, RodsInBiaxialCompressionNeverOverlap) {
+  const sc::Spherocylinder rod{2.0, 0.5};
+  std::vector<sc::Pose> poses;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 2; ++k) poses.push_back({sc::Vec3(0.0, 1.1 * (i - 1), 3.1 * k - 1.55), sc::Quat::Identity()});
+  sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
+  sc::TimeStepperOptions o = options(0.01, 0.01);
+  o.background_flow = sc::LinearBackgroundFlow::biaxial_compression(1.0);
+  sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({rod}, poses, mobility, kBarrierSlsqp, o);
+  std::size_t active = 0;
+  for (int step = 1; step <= 60; ++step) {
+    const sc::StepDiagnostics& d = stepper.step();
+    const double d_min = sc::minimum_pair_distance(rod, std::span<const sc::Pose>(stepper.poses())).distance;
+    ASSERT_GE(d_min, 0.01 * (1.0 - kMargin)) << "step " << step;
+    EXPECT_EQ(d.unconstrained_applications, 0u);
+    active += d.active_pairs;
+  }
+  EXPECT_GT(active, 0u);
+}
+
+// A step whose contact solve fails separation throws and leaves Q_t. A at 0 rushes into B
+// at 2.5; B, pushed by the contact, hits C at 4.6, a pair the trial step does not flag
+// (B is at rest there, 0.1 > d_try away). Without guarantee rounds the solve must fail.
+TEST(TimeStepper, FailedSeparationIsSurfacedAndTheStateKept) {
+  const std::vector<sc::Pose> start = {{sc::Vec3(0, 0, 0), sc::Quat::Identity()},
+                                       {sc::Vec3(2.5, 0, 0), sc::Quat::Identity()},
+                                       {sc::Vec3(4.6, 0, 0), sc::Quat::Identity()}};
+  sc::TimeStepperOptions o = options(0.1, 0.01);
+  o.d_try = 0.015;
+  sc::VecX F = sc::VecX::Zero(9);
+  F(0) = 10.0 / kMu;
+  const SphereSolver no_guarantee = [](const sc::ContactStepProblem<sc::Sphere>& p, sc::FreeDrainingMobility& m) {
+    sc::ContactStepOptions c;
+    c.max_guarantee_rounds = 0;
+    return sc::solve_contact_step_lcp_sequence(p, m, c);
+  };
+  auto mobility = sphere_mobility(3, 3);
+  SphereStepper stepper({sc::Sphere{1.0}}, start, mobility, no_guarantee, o);
+  stepper.set_external_forces(F);
+  std::ostringstream json;
+  stepper.set_diagnostics_output(&json);
+  try {
+    stepper.step();
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("failed separation"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(stepper.time(), 0.0);
+  EXPECT_EQ(stepper.steps_taken(), 0);
+  EXPECT_TRUE(stepper.diagnostics().empty());
+  EXPECT_TRUE(json.str().empty());
+  for (std::size_t b = 0; b < 3; ++b) EXPECT_EQ(stepper.poses()[b].x, start[b].x);
+  // The same step with the guarantee loop adds the B-C pair and succeeds.
+  auto mobility2 = sphere_mobility(3, 3);
+  SphereStepper guarded({sc::Sphere{1.0}}, start, mobility2, kLcpSequence, o);
+  guarded.set_external_forces(F);
+  const sc::StepDiagnostics& d = guarded.step();
+  EXPECT_EQ(d.flagged_pairs, 2u);
+  EXPECT_GE(brute_force_min_distance(guarded.poses()), 0.01 * (1.0 - kMargin));
+}
+
+TEST(TimeStepper, DiagnosticsAreWrittenAsOneJsonObjectPerLine) {
+  auto mobility = sphere_mobility(2, 3);
+  SphereStepper stepper({sc::Sphere{1.0}},
+                        {sc::Pose{sc::Vec3(0, 0, 0), sc::Quat::Identity()},
+                         sc::Pose{sc::Vec3(2.02, 0, 0), sc::Quat::Identity()}},
+                        mobility, kLcpSequence, options(0.01, 0.01));
+  sc::VecX F(6);
+  F << 1.0 / kMu, 0, 0, -1.0 / kMu, 0, 0;
+  stepper.set_external_forces(F);
+  std::ostringstream out;
+  stepper.set_diagnostics_output(&out);
+  stepper.run(3);
+  std::istringstream lines(out.str());
+  std::string line;
+  int k = 0;
+  while (std::getline(lines, line)) {
+    const sc::StepDiagnostics& d = stepper.diagnostics()[static_cast<std::size_t>(k)];
+    ++k;
+    EXPECT_EQ(line.front(), '{');
+    EXPECT_EQ(line.back(), '}');
+    EXPECT_EQ(line, sc::to_json(d));
+    for (const std::string& field :
+         {"\"step\": " + std::to_string(k), "\"time\": " + sc::json_number(d.time),
+          "\"min_distance_ratio\": " + sc::json_number(d.min_distance_ratio), std::string("\"status\": \"converged\""),
+          "\"mobility_applications\": " + std::to_string(d.mobility_applications),
+          "\"flagged_pairs\": " + std::to_string(d.flagged_pairs), "\"lambda_sum\": " + sc::json_number(d.lambda_sum)})
+      EXPECT_NE(line.find(field), std::string::npos) << field << " not in " << line;
+  }
+  EXPECT_EQ(k, 3);
+  EXPECT_GT(stepper.diagnostics()[0].active_pairs, 0u);
+  // Strings are escaped; infinities become null.
+  sc::StepDiagnostics d;
+  d.message = "a \"quoted\"\nline";
+  d.min_distance_ratio = std::numeric_limits<double>::infinity();
+  const std::string json = sc::to_json(d);
+  EXPECT_NE(json.find(R"("message": "a \"quoted\"\u000aline")"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"("min_distance_ratio": null)"), std::string::npos) << json;
+}
+
+TEST(TimeStepper, RejectsBadInputBeforeChangingAnything) {
+  const std::vector<sc::Sphere> shape = {sc::Sphere{1.0}};
+  const std::vector<sc::Pose> two = {{sc::Vec3(0, 0, 0), sc::Quat::Identity()},
+                                     {sc::Vec3(3, 0, 0), sc::Quat::Identity()}};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto mobility = sphere_mobility(2, 3);
+  auto make = [&](const sc::TimeStepperOptions& o) { SphereStepper s(shape, two, mobility, kLcpSequence, o); };
+  for (const double dt : {0.0, -1.0, nan}) {
+    sc::TimeStepperOptions o = options(dt, 0.01);
+    expect_rejects([&] { make(o); }, "dt");
+  }
+  for (const double d_hat : {0.0, -0.1, nan}) {
+    sc::TimeStepperOptions o = options(0.01, d_hat);
+    expect_rejects([&] { make(o); }, "d_hat");
+  }
+  {
+    sc::TimeStepperOptions o = options(0.01, 0.01);
+    o.d_try = 0.005;
+    expect_rejects([&] { make(o); }, "d_try");
+    o.d_try = 0.0;
+    o.d_try_multiplier = 0.5;
+    expect_rejects([&] { make(o); }, "d_try_multiplier");
+    o.d_try_multiplier = 1.0;
+    o.box = sc::PeriodicBox{sc::Vec3(20, 20, 0)};
+    expect_rejects([&] { make(o); }, "box.lengths");
+    o.box = sc::PeriodicBox{sc::Vec3::Constant(20)};
+    o.background_flow = sc::LinearBackgroundFlow::shear(1.0);
+    expect_rejects([&] { make(o); }, "background_flow");
+  }
+  const sc::TimeStepperOptions good = options(0.01, 0.01);
+  expect_rejects([&] { SphereStepper s(shape, two, mobility, SphereSolver{}, good); }, "contact_solver");
+  expect_rejects([&] { SphereStepper s(shape, two, mobility, kLcpSequence, good, nan); }, "t0");
+  {
+    auto wrong = sphere_mobility(3, 3);
+    expect_rejects([&] { SphereStepper s(shape, two, wrong, kLcpSequence, good); }, "mobility");
+  }
+  expect_rejects([&] { SphereStepper s({sc::Sphere{1.0}, sc::Sphere{1.0}, sc::Sphere{1.0}}, two, mobility,
+                                       kLcpSequence, good); },
+                 "shapes");
+  expect_rejects([&] { SphereStepper s(shape, {two[0], sc::Pose{sc::Vec3(1.5, 0, 0), sc::Quat::Identity()}},
+                                       mobility, kLcpSequence, good); },
+                 "poses");
+
+  // Forces: rejected at set time, the previous forces kept.
+  SphereStepper stepper(shape, two, mobility, kLcpSequence, good);
+  SphereStepper twin(shape, two, mobility, kLcpSequence, good);
+  sc::VecX F(6);
+  F << 1, 2, 3, -1, 0, 0.5;
+  stepper.set_external_forces(F);
+  twin.set_external_forces(F);
+  sc::VecX bad = F;
+  bad(4) = nan;
+  expect_rejects([&] { stepper.set_external_forces(bad); }, "external_forces");
+  expect_rejects([&] { stepper.set_external_forces(sc::VecX::Ones(5)); }, "external_forces");
+  expect_rejects([&] { stepper.set_external_force_field(sc::ExternalForceField{}); }, "external_forces");
+  expect_rejects([&] { stepper.run(-1); }, "steps");
+  stepper.step();
+  twin.step();
+  for (std::size_t b = 0; b < 2; ++b) EXPECT_EQ(stepper.poses()[b].x, twin.poses()[b].x);
+
+  // A force field that returns bad forces is caught at the step, before anything moves.
+  for (const sc::VecX& returned : {sc::VecX(sc::VecX::Ones(7)), bad}) {
+    stepper.set_external_force_field([returned](double, std::span<const sc::Pose>) { return returned; });
+    const std::vector<sc::Pose> before = stepper.poses();
+    const double t = stepper.time();
+    const std::size_t applications = mobility.applications();
+    expect_rejects([&] { stepper.step(); }, "external_forces");
+    EXPECT_EQ(stepper.time(), t);
+    EXPECT_EQ(stepper.diagnostics().size(), 1u);
+    EXPECT_EQ(mobility.applications(), applications);
+    for (std::size_t b = 0; b < 2; ++b) EXPECT_EQ(stepper.poses()[b].x, before[b].x);
+  }
+}
+
+}  // namespace
