@@ -17,6 +17,7 @@
 #include "contact/random_scenes.hpp"
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/solver_barrier_nlopt.hpp"
+#include "stokescontact/contact/solver_default.hpp"
 #include "stokescontact/contact/solver_lcp_sequence.hpp"
 #include "stokescontact/geometry/closest_points.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
@@ -31,13 +32,20 @@ using test_support::uniform_vector;
 constexpr double kMargin = 1e-3;  // ContactStepOptions::separation_margin
 constexpr double kL = 10.0;       // box side
 
-enum class Solver { kLcpSequence, kBarrierSlsqp };
-const std::vector<Solver> kSolvers = {Solver::kLcpSequence, Solver::kBarrierSlsqp};
-std::string name(Solver s) { return s == Solver::kLcpSequence ? "lcp_sequence" : "barrier_slsqp"; }
+enum class Solver { kLcpSequence, kBarrierSlsqp, kDefault };
+const std::vector<Solver> kSolvers = {Solver::kLcpSequence, Solver::kBarrierSlsqp, Solver::kDefault};
+std::string name(Solver s) {
+  return s == Solver::kLcpSequence ? "lcp_sequence" : s == Solver::kBarrierSlsqp ? "barrier_slsqp" : "default";
+}
 
 template <sc::Shape S>
 sc::ContactStepResult solve(Solver s, const sc::ContactStepProblem<S>& p, sc::FreeDrainingMobility& m) {
-  return s == Solver::kLcpSequence ? sc::solve_contact_step_lcp_sequence(p, m) : sc::solve_contact_step_barrier(p, m);
+  switch (s) {
+    case Solver::kLcpSequence: return sc::solve_contact_step_lcp_sequence(p, m);
+    case Solver::kBarrierSlsqp: return sc::solve_contact_step_barrier(p, m);
+    case Solver::kDefault: return sc::solve_contact_step_default(p, m);
+  }
+  return {};
 }
 
 // Smallest d^P over all pairs and all 27 neighbouring images: no minimum-image code involved.

@@ -17,6 +17,7 @@
 
 #include "common/test_support.hpp"
 #include "stokescontact/contact/solver_barrier_nlopt.hpp"
+#include "stokescontact/contact/solver_default.hpp"
 #include "stokescontact/contact/solver_lcp_sequence.hpp"
 #include "stokescontact/dynamics/background_flow.hpp"
 #include "stokescontact/dynamics/time_stepper.hpp"
@@ -45,6 +46,10 @@ const auto kLcpSequence = [](const auto& problem, auto& mobility) {
 const auto kBarrierSlsqp = [](const auto& problem, auto& mobility) {
   return sc::solve_contact_step_barrier(problem, mobility);
 };
+const auto kDefault = [](const auto& problem, auto& mobility) {
+  return sc::solve_contact_step_default(problem, mobility);
+};
+constexpr double kDefaultMargin = 1e-4;  // DefaultSolverOptions::margin
 
 sc::FreeDrainingMobility sphere_mobility(std::size_t n, int dofs) {
   return sc::FreeDrainingMobility(sc::sphere_mobility(sc::Sphere{1.0}, 1.0), n, dofs);
@@ -138,8 +143,8 @@ TEST(TimeStepper, ForcesAndBackgroundFlowAdd) {
 // d_hat, the contact force balancing f (lambda = f once they rest there).
 TEST(TimeStepper, TwoSpheresDrivenHeadOnSettleAtDHat) {
   const double dt = 0.01, d_hat = 0.01, f = 1.0 / kMu;
-  const std::vector<std::pair<std::string, SphereSolver>> solvers = {{"lcp_sequence", kLcpSequence},
-                                                                       {"barrier_slsqp", kBarrierSlsqp}};
+  const std::vector<std::pair<std::string, SphereSolver>> solvers = {
+      {"lcp_sequence", kLcpSequence}, {"barrier_slsqp", kBarrierSlsqp}, {"default", kDefault}};
   for (const auto& [name, solver] : solvers) {
     SCOPED_TRACE(name);
     auto mobility = sphere_mobility(2, 3);
@@ -170,6 +175,9 @@ TEST(TimeStepper, TwoSpheresDrivenHeadOnSettleAtDHat) {
                 d / d_hat, last.lambda_max / f, contact_steps);
     if (name == "lcp_sequence") {
       EXPECT_NEAR(d, d_hat, 1e-9 * d_hat);
+      EXPECT_NEAR(last.lambda_max, f, 1e-6 * f);
+    } else if (name == "default") {  // held at d_hat (1 + margin)
+      EXPECT_NEAR(d, d_hat * (1.0 + kDefaultMargin), 1e-9 * d_hat);
       EXPECT_NEAR(last.lambda_max, f, 1e-6 * f);
     } else {  // the barrier stops by eq. 29 (TOL = 1e-2) within the separation margin
       EXPECT_NEAR(d, d_hat, 2e-3 * d_hat);
@@ -257,27 +265,33 @@ TEST(TimeStepper, ManySpheresInAPeriodicBoxNeverOverlapAndStayWrapped) {
 }
 
 // Rods in the yz plane squeezed by biaxial compression (the setting of Broms & Tornberg Sec.
-// 3.2.3, eq. 32), 6 dofs: no overlap at any step, and contacts did occur. The barrier method:
-// on this scene of exactly parallel rods the LCP sequence (default options) stops at step 18
-// with min d / d_hat = 0.949 after 20 LCPs, and the stepper throws (see the report of issue #4).
+// 3.2.3, eq. 32), 6 dofs: no overlap at any step, and contacts did occur. The barrier method
+// and the default: on this scene of exactly parallel rods the LCP sequence (default options)
+// stops at step 18 with min d / d_hat = 0.949 after 20 LCPs, and the stepper throws.
 TEST(TimeStepper, RodsInBiaxialCompressionNeverOverlap) {
+  using RodStepper = sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility>;
   const sc::Spherocylinder rod{2.0, 0.5};
   std::vector<sc::Pose> poses;
   for (int i = 0; i < 3; ++i)
     for (int k = 0; k < 2; ++k) poses.push_back({sc::Vec3(0.0, 1.1 * (i - 1), 3.1 * k - 1.55), sc::Quat::Identity()});
-  sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
-  sc::TimeStepperOptions o = options(0.01, 0.01);
-  o.background_flow = sc::LinearBackgroundFlow::biaxial_compression(1.0);
-  sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({rod}, poses, mobility, kBarrierSlsqp, o);
-  std::size_t active = 0;
-  for (int step = 1; step <= 60; ++step) {
-    const sc::StepDiagnostics& d = stepper.step();
-    const double d_min = sc::minimum_pair_distance(rod, std::span<const sc::Pose>(stepper.poses())).distance;
-    ASSERT_GE(d_min, 0.01 * (1.0 - kMargin)) << "step " << step;
-    EXPECT_EQ(d.unconstrained_applications, 0u);
-    active += d.active_pairs;
+  const std::vector<std::pair<std::string, RodStepper::ContactSolver>> solvers = {{"barrier_slsqp", kBarrierSlsqp},
+                                                                                {"default", kDefault}};
+  for (const auto& [name, solver] : solvers) {
+    SCOPED_TRACE(name);
+    sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
+    sc::TimeStepperOptions o = options(0.01, 0.01);
+    o.background_flow = sc::LinearBackgroundFlow::biaxial_compression(1.0);
+    RodStepper stepper({rod}, poses, mobility, solver, o);
+    std::size_t active = 0;
+    for (int step = 1; step <= 60; ++step) {
+      const sc::StepDiagnostics& d = stepper.step();
+      const double d_min = sc::minimum_pair_distance(rod, std::span<const sc::Pose>(stepper.poses())).distance;
+      ASSERT_GE(d_min, 0.01 * (name == "default" ? 1.0 - 1e-9 : 1.0 - kMargin)) << "step " << step;
+      EXPECT_EQ(d.unconstrained_applications, 0u);
+      active += d.active_pairs;
+    }
+    EXPECT_GT(active, 0u);
   }
-  EXPECT_GT(active, 0u);
 }
 
 // A step whose contact solve fails separation throws and leaves Q_t. A at 0 rushes into B

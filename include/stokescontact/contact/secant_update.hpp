@@ -27,6 +27,10 @@ class SecantCorrection {
   }
 
   std::size_t size() const { return steps_.size(); }
+  void clear() {
+    steps_.clear();
+    changes_.clear();
+  }
 
   // A0 (on the working set `rows`, indices into the full space) corrected by every step.
   MatX corrected(const MatX& A0, std::span<const Eigen::Index> rows) const {

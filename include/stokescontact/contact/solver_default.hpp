@@ -105,14 +105,23 @@ ContactSolveOutcome solve_default_round(ContactStep<S, M>& step, VecX lambda, co
     joining.push_back(k);
   };
   VecX previous_lambda, previous_distances;
+  double previous_shortfall = std::numeric_limits<double>::infinity();
   for (;;) {
     const ContactEvaluation& e = step.evaluate(lambda);
     // The working set: every pair below the target or pushed...
     std::vector<Eigen::Index> joining;
     for (Eigen::Index k = 0; k < step.nc(); ++k)
       if (e.distances(k) < target || lambda(k) > 0.0) join(joining, k);
-    if (previous_lambda.size() > 0 && out.iterations > 1)  // the first step is far from linear
+    // Secant pairs from the second correction on (the first is far from linear); a correction
+    // that made the worst shortfall grow shows the model is not to be trusted (line contacts
+    // whose closest points jump, e.g. parallel rods): the memory is dropped.
+    const double shortfall = std::max(0.0, target - e.min_distance());
+    if (shortfall > previous_shortfall) {
+      secant.clear();
+    } else if (out.iterations > 1) {
       secant.add(lambda - previous_lambda, e.distances - previous_distances);
+    }
+    previous_shortfall = shortfall;
     VecX next;
     for (;;) {
       probing.add(step, joining);
