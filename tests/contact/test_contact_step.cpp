@@ -239,6 +239,35 @@ TEST(ContactStep, SolversAgreeOnRandomSphereScenes) {
   }
 }
 
+// Sec. 3.1.2: each objective's solution is the better one in its own measure (up to the eq. 29
+// stopping rule): the dissipation objective dissipates no more, the 1-norm one pushes no more.
+TEST(ContactStep, EachBarrierObjectiveWinsInItsOwnMeasure) {
+  for (const std::uint64_t seed : {11u, 12u}) {
+    const SphereScene s = random_spheres(seed, 30, 8.0, 10.0);
+    const auto solve = [&](sc::BarrierObjective objective) {
+      auto m = s.mobility();
+      sc::BarrierNloptOptions bar;
+      bar.objective = objective;
+      bar.tol = 1e-4;
+      return sc::solve_contact_step_barrier(s.problem(), m, {}, bar);
+    };
+    const sc::ContactStepResult sum = solve(sc::BarrierObjective::lambda_sum);
+    const sc::ContactStepResult dissipation = solve(sc::BarrierObjective::dissipation);
+    // lambda^T D^T M D lambda = (D lambda) . (M D lambda), M D lambda = the velocity correction.
+    const auto dissipated = [&](const sc::ContactStepResult& r) { return r.contact_forces.dot(r.velocities - s.U); };
+    std::printf("[objectives seed %d] sum objective: sum %.6f dissipation %.6f; dissipation objective: sum %.6f "
+                "dissipation %.6f\n",
+                static_cast<int>(seed), sum.lambda_sum, dissipated(sum), dissipation.lambda_sum, dissipated(dissipation));
+    for (const sc::ContactStepResult* r : {&sum, &dissipation}) {
+      EXPECT_EQ(r->status, sc::ContactStepStatus::converged) << r->message;
+      EXPECT_GE(r->min_distance_ratio, 1.0 - 1e-3);
+      expect_third_law(*r, 3);
+    }
+    EXPECT_LE(dissipated(dissipation), dissipated(sum) * (1.0 + 1e-3));
+    EXPECT_LE(sum.lambda_sum, dissipation.lambda_sum * (1.0 + 1e-3));
+  }
+}
+
 // A few spherocylinders with random velocities and rotations, 6 dofs per body, eq. 30.
 TEST(ContactStep, SolversAgreeOnRodScenes) {
   const sc::Spherocylinder rod{4.0, 0.5};

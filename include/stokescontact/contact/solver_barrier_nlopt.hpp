@@ -13,6 +13,10 @@
 // one mobility application in matrix_free mode, free once M D is formed; none where every
 // b' = 0. Each barrier-energy evaluation costs one application for M D lambda (matrix_free).
 //
+// Objective (eq. 14-15, Sec. 3.1.2): sum_k lambda_k by default, or the dissipation
+// lambda^T D^T M D lambda = (D lambda) . (M D lambda), gradient 2 D^T (M D lambda). Both come
+// from the evaluation at lambda that the constraint needs too (cached): no extra application.
+//
 // Variables are scaled, lambda = s x with s = d_try / (dt c), c = v^T D^T M D v / v^T v for
 // v = 1 (one application, or free once formed), so x is O(1) for a typical correction.
 //
@@ -21,6 +25,7 @@
 // satisfy d >= d_hat (1 - separation_margin). NLopt's own limits (max evaluations, xtol) back
 // it up; the cheapest separated point seen is returned when NLopt stops first.
 // Iterations reported: barrier-energy evaluations (NLopt does not expose its iterations).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -37,8 +42,12 @@ namespace stokescontact {
 // handful of pairs, but in our tests it needs more than 1000 evaluations from Nc ~ 20 on).
 enum class BarrierOptimizer { slsqp, cobyla, mma };
 
+// The norm of lambda that eq. 15 minimises (eq. 14).
+enum class BarrierObjective { lambda_sum, dissipation };
+
 struct BarrierNloptOptions {
   BarrierOptimizer optimizer = BarrierOptimizer::slsqp;
+  BarrierObjective objective = BarrierObjective::lambda_sum;
   double tol = 1e-2;                 // eq. 29
   double eps_reg = -1.0;             // < 0: d_try (Remark 4)
   int max_evaluations = 1000;        // barrier-energy evaluations per round
@@ -75,6 +84,7 @@ struct BarrierRound {
   nlopt::opt* opt = nullptr;
   BarrierParameters barrier;
   double scale = 1.0;    // lambda = scale x
+  double curvature = 1.0;  // 1^T D^T M D 1 / Nc
   double energy_scale = 1.0;
   int evaluations = 0;
   std::optional<VecX> previous;  // lambda at the previous evaluation
@@ -113,13 +123,26 @@ struct BarrierRound {
     return energy / energy_scale;
   }
 
-  static double objective(const std::vector<double>& x, std::vector<double>& grad, void*) {
-    double sum = 0.0;
-    for (std::size_t k = 0; k < x.size(); ++k) {
-      sum += x[k];
-      if (!grad.empty()) grad[k] = 1.0;
+  // sum x_k, or the dissipation in units of scale^2 c (c the curvature along 1, so both are
+  // O(Nc) for x = 1).
+  double objective(const std::vector<double>& x, std::vector<double>& grad) {
+    const Eigen::Map<const VecX> xs(x.data(), static_cast<Eigen::Index>(x.size()));
+    if (options.objective == BarrierObjective::lambda_sum) {
+      if (!grad.empty()) std::fill(grad.begin(), grad.end(), 1.0);
+      return xs.sum();
     }
-    return sum;
+    const ContactEvaluation& e = step.evaluate(scale * xs);
+    const VecX D_lambda = step.D() * e.lambda;
+    const double unit = scale * scale * curvature;
+    if (!grad.empty()) {
+      const VecX g = (2.0 * scale / unit) * (step.D().transpose() * e.MD_lambda);
+      Eigen::Map<VecX>(grad.data(), g.size()) = g;
+    }
+    return D_lambda.dot(e.MD_lambda) / unit;
+  }
+
+  static double objective_callback(const std::vector<double>& x, std::vector<double>& grad, void* data) {
+    return static_cast<BarrierRound*>(data)->objective(x, grad);
   }
 
   static double constraint_callback(const std::vector<double>& x, std::vector<double>& grad, void* data) {
@@ -143,11 +166,12 @@ ContactSolveOutcome solve_barrier_round(ContactStep<S, M>& step, const VecX& war
   const VecX ones = VecX::Ones(nc);
   const double c = VecX(step.D() * ones).dot(step.MD_times(ones)) / static_cast<double>(nc);
   round.scale = c > 0.0 ? step.d_try() / (dt * c) : 1.0;
+  round.curvature = c > 0.0 ? c : 1.0;
   round.energy_scale = d_hat * d_hat;
 
   nlopt::opt opt(nlopt_algorithm(options.optimizer), static_cast<unsigned>(nc));
   round.opt = &opt;
-  opt.set_min_objective(&BarrierRound<S, M>::objective, nullptr);
+  opt.set_min_objective(&BarrierRound<S, M>::objective_callback, &round);
   opt.add_inequality_constraint(&BarrierRound<S, M>::constraint_callback, &round, 0.0);  // E <= 0, eq. 15
   opt.set_lower_bounds(0.0);
   opt.set_maxeval(options.max_evaluations);
