@@ -4,7 +4,11 @@
 //
 // Given a contact-free configuration Q_t and the unconstrained velocities U (the caller's
 // mobility solve, not counted here), the trial step Q* = Q_t + dt Psi U (eq. 16) flags the
-// Nc pairs with d^P <= d_try (eq. 30/31) and builds the contact matrix D at Q* (eq. 20-21).
+// Nc pairs with d^P <= d_try (eq. 30/31) and builds the contact matrix D at Q*: from the
+// closest points (d^P, eq. 20-21) or from the surface-node pairs within d_try (d^S, eq.
+// 22-23; by default for boomerangs, whose non-convex contacts may touch at several places).
+// The constraint is on d^P in both cases (d^S <= d^P for every node pair, Sec. 3.2.1, so
+// d^P >= d_hat is the stricter); d^S only spreads each contact's force over its node pairs.
 // A solver then looks for contact magnitudes lambda >= 0 so that the corrected configuration
 //     Q(lambda) = Q_t + dt Psi (U + M D lambda)        (eq. 13, M at Q_t)
 // keeps every pair at d >= d_hat. Two cost modes for M D lambda:
@@ -28,6 +32,7 @@
 #include <span>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -37,6 +42,7 @@
 #include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/contact/contact_pairs.hpp"
 #include "stokescontact/contact/d_try.hpp"
+#include "stokescontact/contact/surface_contacts.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 #include "stokescontact/mobility/mobility_operator.hpp"
 
@@ -58,12 +64,20 @@ struct ContactStepProblem {
 
 enum class MobilityCost { formed, matrix_free };
 
+// Where contact forces act: the closest points (eq. 21) or the surface-node pairs (eq. 23);
+// automatic: surface for boomerangs, particle for the convex shapes.
+enum class ContactDirections { automatic, particle, surface };
+
 struct ContactStepOptions {
   MobilityCost cost = MobilityCost::formed;
   // A pair is separated when d >= d_hat (1 - separation_margin).
   double separation_margin = 1e-3;
   // Re-solves after adding pairs the trial step missed (the guarantee loop).
   int max_guarantee_rounds = 3;
+  ContactDirections directions = ContactDirections::automatic;
+  // Surface-node spacing h for eq. 23; 0: half the shape's radius.
+  double node_spacing = 0.0;
+  SurfaceWeights surface_weights;
 
   void validate() const {
     if (!(separation_margin >= 0.0 && separation_margin < 1.0))
@@ -72,6 +86,14 @@ struct ContactStepOptions {
     if (max_guarantee_rounds < 0)
       fail_argument("ContactStepOptions.max_guarantee_rounds",
                     "must be >= 0, got " + std::to_string(max_guarantee_rounds));
+    require_non_negative(node_spacing, "ContactStepOptions.node_spacing");
+  }
+
+  // Whether a scene of shape S uses d^S for its contact directions.
+  template <Shape S>
+  bool surface_directions() const {
+    return directions == ContactDirections::surface ||
+           (directions == ContactDirections::automatic && std::is_same_v<S, Boomerang>);
   }
 };
 
@@ -153,6 +175,10 @@ class ContactStep {
       if (!(d_try_ >= problem.d_hat))
         fail_argument("d_try", "must be >= d_hat = " + std::to_string(problem.d_hat) + ", got " +
                                    std::to_string(d_try_));
+    }
+    if (options.surface_directions<S>()) {
+      for (const S& shape : problem.shapes)
+        nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : 0.5 * shape.radius));
     }
     trial_ = advance_all(*problem.U);  // eq. 16
     pairs_ = find_contact_pairs(problem.shapes, std::span<const Pose>(trial_), d_try_, problem.box);
@@ -249,9 +275,26 @@ class ContactStep {
 
   // Pairs are only ever appended: columns of M D already formed stay valid.
   void rebuild() {
-    D_ = contact_matrix(std::span<const ContactPair>(pairs_), std::span<const Pose>(trial_), dofs_);
     last_.reset();
+    const std::span<const Pose> trial(trial_);
+    if (nodes_.empty()) {
+      D_ = contact_matrix(std::span<const ContactPair>(pairs_), trial, dofs_);
+      return;
+    }
+    std::vector<SurfaceContact> contacts;
+    contacts.reserve(pairs_.size());
+    for (const ContactPair& p : pairs_) {
+      const auto i = static_cast<std::size_t>(p.i), j = static_cast<std::size_t>(p.j);
+      contacts.push_back({p.i, p.j, p.image_shift,
+                          surface_distances(shape_of(problem_.shapes, i), trial_[i], nodes_of(i),
+                                            shape_of(problem_.shapes, j), shifted(trial_[j], p.image_shift),
+                                            nodes_of(j), d_try_)});
+    }
+    D_ = surface_contact_matrix(std::span<const SurfaceContact>(contacts), trial, d_try_, dofs_,
+                                options_.surface_weights);
   }
+
+  const SurfaceNodes& nodes_of(std::size_t body) const { return nodes_.size() == 1 ? nodes_[0] : nodes_[body]; }
 
   // Column k of M D, formed on first need (one application).
   const VecX& formed_column(Eigen::Index k) {
@@ -269,6 +312,7 @@ class ContactStep {
   std::size_t start_applications_ = 0;
   std::vector<Pose> trial_;  // Q*
   std::vector<ContactPair> pairs_;
+  std::vector<SurfaceNodes> nodes_;  // per shape, for d^S directions (empty: d^P)
   Eigen::SparseMatrix<double> D_;
   std::vector<VecX> MD_columns_;  // the columns of M D formed so far (empty: not yet)
   std::optional<ContactEvaluation> last_;
