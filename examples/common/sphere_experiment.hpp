@@ -1,0 +1,264 @@
+#pragma once
+// One contact step on a scene of forced unit spheres, Broms & Tornberg Sec. 3.1.1: what the
+// sphere drivers share. A scene is a contact-free packing (sphere_packing.hpp) with
+// d_hat = its minimum gap and forces of random direction, |f_i| = 100. The unconstrained
+// velocities U = M f cost one mobility application, not counted in the contact step; the step
+// itself (dt = 0.01, d^P, d_try of eq. 31 times a multiplier) is run by a registered solver
+// and summarised in a StepRecord.
+#include <stokescontact/stokescontact.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "common/solvers.hpp"
+#include "common/sphere_packing.hpp"
+
+namespace examples {
+
+namespace sc = stokescontact;
+
+inline constexpr double kForceMagnitude = 100.0;  // |f_i|, Sec. 3.1.1
+inline constexpr double kTimeStep = 0.01;         // dt, Sec. 3.1.1
+// A configuration "respects d_hat" when min d / d_hat >= kRespectsDHat (roundoff allowed).
+inline constexpr double kRespectsDHat = 1.0 - 1e-9;
+// A pair is active when lambda_k > kActiveFraction max lambda.
+inline constexpr double kActiveFraction = 1e-12;
+
+// ---------------------------------------------------------------------------------------
+// Mobility models of the sphere scenes.
+
+enum class MobilityModel { multiblob, rpy, free_draining };
+
+inline MobilityModel parse_mobility(const std::string& name) {
+  if (name == "multiblob") return MobilityModel::multiblob;
+  if (name == "rpy") return MobilityModel::rpy;
+  if (name == "free-draining") return MobilityModel::free_draining;
+  throw std::invalid_argument("unknown mobility '" + name + "' (known: multiblob, rpy, free-draining)");
+}
+
+inline const char* mobility_name(MobilityModel m) {
+  switch (m) {
+    case MobilityModel::multiblob: return "multiblob";
+    case MobilityModel::rpy: return "rpy";
+    case MobilityModel::free_draining: return "free-draining";
+  }
+  return "?";
+}
+
+using SphereMobility = std::variant<sc::MultiblobMobility, sc::RpyMobility, sc::FreeDrainingMobility>;
+
+// Unit spheres in viscosity 1. multiblob: the paper's 12-blob icosahedral shell (hydrodynamic
+// radius 1), matrix-free GMRES, 6 dofs per body; rpy and free-draining: translation only.
+inline SphereMobility make_mobility(MobilityModel model, std::size_t n) {
+  switch (model) {
+    case MobilityModel::multiblob: {
+      sc::MultiblobOptions options;
+      options.solver = sc::MultiblobSolver::matrix_free;
+      return SphereMobility(std::in_place_type<sc::MultiblobMobility>, sc::sphere_shell(12, 1.0), n, options);
+    }
+    case MobilityModel::rpy:
+      return SphereMobility(std::in_place_type<sc::RpyMobility>, n, sc::RpyParameters{1.0, 1.0}, 3);
+    case MobilityModel::free_draining:
+      return SphereMobility(std::in_place_type<sc::FreeDrainingMobility>, sc::sphere_mobility(sc::Sphere{1.0}, 1.0),
+                            n, 3);
+  }
+  throw std::invalid_argument("unknown mobility model");
+}
+
+// ---------------------------------------------------------------------------------------
+// Scenes.
+
+enum class PackingKind { random_sequential, dense };
+
+struct SceneSpec {
+  std::string name;  // for the output
+  PackingKind packing = PackingKind::random_sequential;
+  std::size_t spheres = 500;
+  double phi = 0.24;  // target packing fraction
+};
+
+struct SphereScene {
+  std::uint64_t seed = 0;
+  SpherePacking packing;
+  std::vector<sc::Vec3> forces;
+  double d_hat = 0.0;  // the minimum gap (Sec. 3.1.1)
+};
+
+// A reproducible scene from (seed, phi): the packing and the forces from one stream.
+inline SphereScene make_scene(const SceneSpec& spec, std::uint64_t seed) {
+  std::seed_seq sequence{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                         static_cast<std::uint32_t>(spec.phi * 1e6), static_cast<std::uint32_t>(spec.packing)};
+  std::mt19937_64 rng(sequence);
+  SphereScene s;
+  s.seed = seed;
+  s.packing = spec.packing == PackingKind::dense ? dense_packing(spec.spheres, spec.phi, rng())
+                                                 : random_sequential_addition(spec.spheres, spec.phi, rng());
+  s.forces = random_forces(spec.spheres, kForceMagnitude, rng);
+  s.d_hat = s.packing.min_gap;
+  return s;
+}
+
+// Forces stacked for a model with `dofs` per body (zero torques for 6).
+inline sc::VecX stacked_forces(const std::vector<sc::Vec3>& forces, int dofs) {
+  sc::VecX F = sc::VecX::Zero(static_cast<Eigen::Index>(forces.size()) * dofs);
+  for (std::size_t i = 0; i < forces.size(); ++i) F.segment<3>(static_cast<Eigen::Index>(i) * dofs) = forces[i];
+  return F;
+}
+
+// U = M f at Q_t: one application, the caller's (not counted in the contact step).
+template <sc::MobilityOperator M>
+sc::VecX unconstrained_velocities(M& mobility, const SphereScene& scene) {
+  mobility.set_configuration(scene.packing.poses);
+  return mobility.apply(stacked_forces(scene.forces, mobility.dofs_per_body()));
+}
+
+// ---------------------------------------------------------------------------------------
+// One contact step and its numbers.
+
+struct StepSettings {
+  double d_try_multiplier = 1.0;  // Sec. 3.1.2: 1, 1.1, 1.2
+  std::optional<double> tol;      // eq. 29 TOL; none: the solver's own
+  sc::ContactStepOptions options;  // cost mode, separation margin
+  bool pair_details = false;       // keep per-pair distances and forces (Fig. 4c, 4e, 5)
+};
+
+struct StepRecord {
+  double d_hat = 0.0, d_try = 0.0;
+  std::size_t flagged = 0;            // Nc (pairs added by the guarantee loop included)
+  std::size_t active = 0;             // lambda_k > kActiveFraction max lambda
+  std::size_t violating_trial = 0;    // flagged pairs with d < d_hat at the trial step Q*
+  double min_ratio_trial = 0.0;       // min d / d_hat over all pairs at Q*
+  double min_ratio_after = 0.0;       // ... at Q(lambda)
+  int iterations = 0;
+  std::size_t applications = 0;
+  double wall_time_s = 0.0;
+  double lambda_sum = 0.0;
+  double lambda_max_over_f = 0.0;     // max lambda / |f_i|
+  std::string status, message;
+  sc::VecX sphere_forces;             // D lambda, the force part only: 3 per sphere
+  // With pair_details: per flagged pair, d at Q* / d_try, d at Q(lambda) / d_hat, lambda / |f|.
+  bool has_pair_details = false;
+  std::vector<double> pair_trial_over_d_try, pair_after_over_d_hat, pair_lambda_over_f;
+};
+
+inline const char* status_name(sc::ContactStepStatus s) {
+  switch (s) {
+    case sc::ContactStepStatus::converged: return "converged";
+    case sc::ContactStepStatus::not_converged: return "not_converged";
+    case sc::ContactStepStatus::failed_separation: return "failed_separation";
+  }
+  return "?";
+}
+
+namespace detail {
+
+// Q* = Q_t + dt Psi U (eq. 16).
+inline std::vector<sc::Pose> trial_poses(const std::vector<sc::Pose>& poses, const sc::VecX& U, int dofs) {
+  std::vector<sc::Pose> next(poses.size());
+  for (std::size_t b = 0; b < poses.size(); ++b) {
+    const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs;
+    const sc::Vec3 omega = dofs == 6 ? sc::Vec3(U.segment<3>(row + 3)) : sc::Vec3::Zero();
+    next[b] = sc::advance(poses[b], U.segment<3>(row), omega, kTimeStep);
+  }
+  return next;
+}
+
+inline sc::VecX force_part(const sc::VecX& contact_forces, int dofs) {
+  const Eigen::Index n = contact_forces.size() / dofs;
+  sc::VecX f(3 * n);
+  for (Eigen::Index b = 0; b < n; ++b) f.segment<3>(3 * b) = contact_forces.segment<3>(b * dofs);
+  return f;
+}
+
+inline void keep_pair_details(const sc::ContactStepResult& r, StepRecord& out) {
+  const sc::Sphere sphere{1.0};
+  out.has_pair_details = true;
+  for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+    const sc::ContactPair& p = r.pairs[k];
+    const double after = sc::closest_points(sphere, r.poses[static_cast<std::size_t>(p.i)], sphere,
+                                            r.poses[static_cast<std::size_t>(p.j)]).distance;
+    out.pair_trial_over_d_try.push_back(p.points.distance / out.d_try);
+    out.pair_after_over_d_hat.push_back(after / out.d_hat);
+    out.pair_lambda_over_f.push_back(r.lambda(static_cast<Eigen::Index>(k)) / kForceMagnitude);
+  }
+}
+
+}  // namespace detail
+
+template <sc::MobilityOperator M>
+StepRecord run_step(const SolverEntry& solver, const SphereScene& scene, M& mobility, const sc::VecX& U,
+                    const StepSettings& settings) {
+  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  const sc::ContactStepProblem<sc::Sphere> problem{shapes, scene.packing.poses, &U, kTimeStep, scene.d_hat,
+                                                   0.0,    settings.d_try_multiplier, {}};
+  const sc::ContactStepResult r = solve(solver, problem, mobility, settings.options, settings.tol);
+  const int dofs = mobility.dofs_per_body();
+  StepRecord out;
+  out.d_hat = scene.d_hat;
+  out.d_try = r.d_try;
+  out.flagged = r.flagged_pairs;
+  for (Eigen::Index k = 0; k < r.lambda.size(); ++k) {
+    if (r.lambda(k) > kActiveFraction * r.lambda_max) ++out.active;
+    if (r.pairs[static_cast<std::size_t>(k)].points.distance < scene.d_hat) ++out.violating_trial;
+  }
+  const std::vector<sc::Pose> trial = detail::trial_poses(scene.packing.poses, U, dofs);
+  out.min_ratio_trial =
+      sc::minimum_pair_distance(sc::Sphere{1.0}, std::span<const sc::Pose>(trial)).distance / scene.d_hat;
+  out.min_ratio_after = r.min_distance_ratio;
+  out.iterations = r.iterations;
+  out.applications = r.mobility_applications;
+  out.wall_time_s = r.wall_time_s;
+  out.lambda_sum = r.lambda_sum;
+  out.lambda_max_over_f = r.lambda_max / kForceMagnitude;
+  out.status = status_name(r.status);
+  out.message = r.message;
+  out.sphere_forces = detail::force_part(r.contact_forces, dofs);
+  if (settings.pair_details) detail::keep_pair_details(r, out);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// JSON.
+
+inline std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) out += c;
+  }
+  return out + "\"";
+}
+
+inline std::string json_numbers(const std::vector<double>& v) {
+  std::string out = "[";
+  for (std::size_t k = 0; k < v.size(); ++k) out += (k ? ", " : "") + sc::json_number(v[k]);
+  return out + "]";
+}
+
+// The record's fields as `"key": value, ...` (no braces), for a driver's JSON object.
+inline std::string json_fields(const StepRecord& r) {
+  std::ostringstream os;
+  os << "\"d_hat\": " << sc::json_number(r.d_hat) << ", \"d_try\": " << sc::json_number(r.d_try)
+     << ", \"nc\": " << r.flagged << ", \"active_pairs\": " << r.active
+     << ", \"violating_pairs_trial\": " << r.violating_trial
+     << ", \"min_d_over_d_hat_trial\": " << sc::json_number(r.min_ratio_trial)
+     << ", \"min_d_over_d_hat_after\": " << sc::json_number(r.min_ratio_after) << ", \"iterations\": " << r.iterations
+     << ", \"mobility_applications\": " << r.applications << ", \"wall_time_s\": " << sc::json_number(r.wall_time_s)
+     << ", \"lambda_sum\": " << sc::json_number(r.lambda_sum)
+     << ", \"lambda_max_over_f\": " << sc::json_number(r.lambda_max_over_f) << ", \"status\": " << json_string(r.status)
+     << ", \"message\": " << json_string(r.message);
+  if (r.has_pair_details)
+    os << ", \"pair_d_trial_over_d_try\": " << json_numbers(r.pair_trial_over_d_try)
+       << ", \"pair_d_after_over_d_hat\": " << json_numbers(r.pair_after_over_d_hat)
+       << ", \"pair_lambda_over_f\": " << json_numbers(r.pair_lambda_over_f);
+  return os.str();
+}
+
+}  // namespace examples

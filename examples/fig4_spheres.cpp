@@ -1,0 +1,264 @@
+// Broms & Tornberg Fig. 4 (Sec. 3.1.1) and Table 1 (Sec. 3.1.2): one contact step on random
+// suspensions of 500 unit spheres in a cube, packing fractions 24% and 12%, 200 configurations
+// each. Per configuration: d_hat = the minimum gap, forces of random direction with
+// |f_i| = 100, U = M f (one application, not counted), one contact step with dt = 0.01.
+//
+//   fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500]
+//                [--solver NAME] [--mobility multiblob|rpy|free-draining]
+//                [--d-try-multiplier 1] [--tol TOL] [--cost formed|matrix-free]
+//                [--separation-margin 1e-3] [--pairs] [--output FILE] [--table1]
+//
+// Prints one JSON object per configuration (to --output if given, else stdout), then a
+// summary table per phi. --tol sets the eq. 29 TOL of the barrier and default solvers (without
+// it each keeps its own: barrier 1e-2, the paper's). --pairs adds per-pair distances and
+// forces (Fig. 4c, 4e, 5).
+// --table1: the Sec. 3.1.2 sweep d_try x {1, 1.1, 1.2}, TOL in {1e-2, 5e-3, 5e-6} on the
+// first --phi (default 0.24), solver default barrier-slsqp (the paper's), contact forces
+// compared with the reference (d_try x 1, TOL 5e-6).
+#include <stokescontact/stokescontact.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/cli.hpp"
+#include "common/solvers.hpp"
+#include "common/sphere_experiment.hpp"
+
+namespace sc = stokescontact;
+namespace ex = examples;
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500] [--solver NAME]\n"
+    "                    [--mobility multiblob|rpy|free-draining] [--d-try-multiplier 1] [--tol TOL]\n"
+    "                    [--cost formed|matrix-free] [--separation-margin 1e-3] [--pairs] [--output FILE]\n"
+    "                    [--table1]\n";
+
+struct Options {
+  int configs = 200;
+  std::uint64_t seed = 1;
+  std::vector<double> phis;
+  std::size_t spheres = 500;
+  std::string solver;
+  ex::MobilityModel mobility = ex::MobilityModel::multiblob;
+  ex::StepSettings step;
+  std::string output;
+  bool table1 = false;
+};
+
+sc::MobilityCost parse_cost(const std::string& name) {
+  if (name == "formed") return sc::MobilityCost::formed;
+  if (name == "matrix-free") return sc::MobilityCost::matrix_free;
+  throw std::invalid_argument("--cost must be formed or matrix-free, got '" + name + "'");
+}
+
+Options parse(int argc, char** argv) {
+  ex::Arguments args(argc, argv);
+  Options o;
+  o.table1 = args.flag("--table1");
+  o.configs = static_cast<int>(args.integer("--configs", 200, 1));
+  o.seed = static_cast<std::uint64_t>(args.integer("--seed", 1, 0));
+  o.phis = args.numbers("--phi", o.table1 ? std::vector<double>{0.24} : std::vector<double>{0.24, 0.12}, 1e-6);
+  o.spheres = static_cast<std::size_t>(args.integer("--spheres", 500, 2));
+  // Fig. 4 uses the default solver; Table 1 is about the barrier method's TOL (eq. 29).
+  o.solver = ex::find_solver(args.text("--solver", o.table1 ? "barrier-slsqp" : ex::kDefaultSolverName)).name;
+  o.mobility = ex::parse_mobility(args.text("--mobility", "multiblob"));
+  o.step.d_try_multiplier = args.number("--d-try-multiplier", 1.0, 1.0);
+  // TOL (eq. 29) replaces the solver's own when given (barrier: 1e-2, the paper's).
+  o.step.tol = args.positive("--tol");
+  o.step.options.cost = parse_cost(args.text("--cost", "matrix-free"));
+  o.step.options.separation_margin = args.number("--separation-margin", o.step.options.separation_margin, 0.0);
+  o.step.options.validate();
+  o.step.pair_details = args.flag("--pairs");
+  o.output = args.text("--output", "");
+  args.reject_unknown();
+  return o;
+}
+
+const char* cost_name(const Options& o) {
+  return o.step.options.cost == sc::MobilityCost::formed ? "formed" : "matrix-free";
+}
+
+ex::SceneSpec fig4_scene(const Options& o, double phi) {
+  return {"fig4", ex::PackingKind::random_sequential, o.spheres, phi};
+}
+
+std::string step_json(const Options& o, const ex::SphereScene& scene, double phi, int config,
+                      const std::string& extra, const ex::StepRecord& r) {
+  return "{\"record\": \"step\", \"seed\": " + std::to_string(scene.seed) + ", \"config\": " + std::to_string(config) +
+         ", \"phi\": " + sc::json_number(phi) + ", \"phi_reached\": " + sc::json_number(scene.packing.phi) +
+         ", \"spheres\": " + std::to_string(o.spheres) + ", \"mobility\": \"" + ex::mobility_name(o.mobility) +
+         "\", \"solver\": \"" + o.solver + "\", \"cost\": \"" + cost_name(o) + "\"" + extra + ", " +
+         ex::json_fields(r) + "}";
+}
+
+std::string progress(const ex::StepRecord& r, double phi, int config) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "phi %.2f config %3d: Nc %4zu active %3zu min d/d_hat %.6f apps %4zu %8.3f s %s",
+                phi, config, r.flagged, r.active, r.min_ratio_after, r.applications, r.wall_time_s, r.status.c_str());
+  return buf;
+}
+
+// ---------------------------------------------------------------------------------------
+// Fig. 4
+
+struct PhiSummary {
+  std::vector<double> min_after, applications, wall, nc;
+  int respects = 0;  // configs with min d >= d_hat (1 - 1e-9)
+
+  void add(const ex::StepRecord& r) {
+    min_after.push_back(r.min_ratio_after);
+    applications.push_back(static_cast<double>(r.applications));
+    wall.push_back(r.wall_time_s);
+    nc.push_back(static_cast<double>(r.flagged));
+    respects += r.min_ratio_after >= ex::kRespectsDHat;
+  }
+};
+
+void print_fig4_summary(const Options& o, const std::vector<std::pair<double, PhiSummary>>& rows) {
+  std::printf("\nFig. 4: %zu spheres, %s mobility, solver %s, cost %s, d_try x %g, TOL %s\n", o.spheres,
+              ex::mobility_name(o.mobility), o.solver.c_str(), cost_name(o), o.step.d_try_multiplier,
+              o.step.tol ? sc::json_number(*o.step.tol).c_str() : "the solver's own");
+  std::printf("%5s %7s | %-29s | %9s | %-13s | %9s | %7s\n", "phi", "configs", "min d/d_hat after (min med max)",
+              "d>=d_hat", "apps (med max)", "med wall", "med Nc");
+  for (const auto& [phi, s] : rows)
+    std::printf("%5.2f %7zu | %9.6f %9.6f %9.6f | %8.1f%% | %6.0f %6.0f | %8.3fs | %7.0f\n", phi, s.min_after.size(),
+                ex::minimum(s.min_after), ex::median(s.min_after), ex::maximum(s.min_after),
+                100.0 * s.respects / static_cast<double>(s.min_after.size()), ex::median(s.applications),
+                ex::maximum(s.applications), ex::median(s.wall), ex::median(s.nc));
+}
+
+template <sc::MobilityOperator M>
+void run_fig4(const Options& o, M& mobility) {
+  const ex::SolverEntry& solver = ex::find_solver(o.solver);
+  ex::JsonLines sink(o.output);
+  std::vector<std::pair<double, PhiSummary>> rows;
+  for (const double phi : o.phis) {
+    PhiSummary summary;
+    for (int c = 0; c < o.configs; ++c) {
+      const ex::SphereScene scene = ex::make_scene(fig4_scene(o, phi), o.seed + static_cast<std::uint64_t>(c));
+      const sc::VecX U = ex::unconstrained_velocities(mobility, scene);
+      const ex::StepRecord r = ex::run_step(solver, scene, mobility, U, o.step);
+      sink.line(step_json(o, scene, phi, c, "", r), progress(r, phi, c));
+      summary.add(r);
+    }
+    rows.emplace_back(phi, std::move(summary));
+  }
+  print_fig4_summary(o, rows);
+}
+
+// ---------------------------------------------------------------------------------------
+// Table 1 (Sec. 3.1.2): contact forces per sphere against the reference (d_try x 1, TOL 5e-6).
+//   msd:          mean over all force components (3 per sphere, every sphere of every
+//                 configuration) of (f - f_ref)^2; msd_over_f2 divides it by |f_i|^2 = 100^2.
+//   max_rel_diff: max |f - f_ref| / max |f_ref|, both maxima over all those components
+//                 (one ratio for the whole sweep, not a maximum of per-configuration ratios).
+
+constexpr std::array<double, 3> kMultipliers{1.0, 1.1, 1.2};
+constexpr std::array<double, 3> kTols{1e-2, 5e-3, 5e-6};
+
+struct ForceDeviation {
+  double squared_sum = 0.0, components = 0.0, max_diff = 0.0, max_ref = 0.0;
+  std::vector<double> applications, nc;
+  double min_after = std::numeric_limits<double>::infinity();
+
+  void add(const ex::StepRecord& r, const sc::VecX& reference) {
+    const sc::VecX diff = r.sphere_forces - reference;
+    squared_sum += diff.squaredNorm();
+    components += static_cast<double>(diff.size());
+    max_diff = std::max(max_diff, diff.cwiseAbs().maxCoeff());
+    max_ref = std::max(max_ref, reference.cwiseAbs().maxCoeff());
+    applications.push_back(static_cast<double>(r.applications));
+    nc.push_back(static_cast<double>(r.flagged));
+    min_after = std::min(min_after, r.min_ratio_after);
+  }
+  double msd() const { return squared_sum / components; }
+  double max_rel_diff() const { return max_ref > 0.0 ? max_diff / max_ref : 0.0; }
+};
+
+void print_table1(const Options& o, const std::map<std::pair<int, int>, ForceDeviation>& dev, ex::JsonLines& sink) {
+  std::printf("\nTable 1: %zu spheres, phi %.2f, %d configs, %s mobility, solver %s; reference d_try x 1, TOL 5e-6\n",
+              o.spheres, o.phis.front(), o.configs, ex::mobility_name(o.mobility), o.solver.c_str());
+  std::printf("%-9s %-8s | %11s %11s | %12s | %9s %9s | %s\n", "d_try", "TOL", "msd", "msd/|f|^2", "max rel diff",
+              "med apps", "med Nc", "min d/d_hat after");
+  for (const auto& [key, d] : dev) {
+    const double mult = kMultipliers[static_cast<std::size_t>(key.first)];
+    const double tol = kTols[static_cast<std::size_t>(key.second)];
+    std::printf("x %-7.1f %-8.0e | %11.3e %11.3e | %12.3g | %9.0f %9.0f | %.6f\n", mult, tol, d.msd(),
+                d.msd() / (ex::kForceMagnitude * ex::kForceMagnitude), d.max_rel_diff(), ex::median(d.applications),
+                ex::median(d.nc), d.min_after);
+  }
+  for (const auto& [key, d] : dev) {
+    const double mult = kMultipliers[static_cast<std::size_t>(key.first)];
+    const double tol = kTols[static_cast<std::size_t>(key.second)];
+    sink.line("{\"record\": \"table1\", \"d_try_multiplier\": " + sc::json_number(mult) +
+                  ", \"tol\": " + sc::json_number(tol) + ", \"configs\": " + std::to_string(o.configs) +
+                  ", \"msd\": " + sc::json_number(d.msd()) +
+                  ", \"msd_over_f2\": " + sc::json_number(d.msd() / (ex::kForceMagnitude * ex::kForceMagnitude)) +
+                  ", \"max_rel_diff\": " + sc::json_number(d.max_rel_diff()) +
+                  ", \"median_applications\": " + sc::json_number(ex::median(d.applications)) +
+                  ", \"median_nc\": " + sc::json_number(ex::median(d.nc)) +
+                  ", \"min_d_over_d_hat_after\": " + sc::json_number(d.min_after) + "}",
+              "");
+  }
+}
+
+template <sc::MobilityOperator M>
+void run_table1(const Options& o, M& mobility) {
+  const ex::SolverEntry& solver = ex::find_solver(o.solver);
+  if (!ex::has_tol(solver))
+    std::fprintf(stderr, "note: %s has no TOL (eq. 29); only d_try varies\n", solver.name.c_str());
+  const double phi = o.phis.front();
+  ex::JsonLines sink(o.output);
+  std::map<std::pair<int, int>, ForceDeviation> deviations;
+  for (int c = 0; c < o.configs; ++c) {
+    const ex::SphereScene scene = ex::make_scene(fig4_scene(o, phi), o.seed + static_cast<std::uint64_t>(c));
+    const sc::VecX U = ex::unconstrained_velocities(mobility, scene);
+    std::optional<sc::VecX> reference;  // (x 1, 5e-6): the first combination run
+    for (const int t : {2, 0, 1})
+      for (int m = 0; m < 3; ++m) {
+        ex::StepSettings settings = o.step;
+        settings.d_try_multiplier = kMultipliers[static_cast<std::size_t>(m)];
+        settings.tol = kTols[static_cast<std::size_t>(t)];
+        const ex::StepRecord r = ex::run_step(solver, scene, mobility, U, settings);
+        if (!reference) reference = r.sphere_forces;
+        deviations[{m, t}].add(r, *reference);
+        const std::string extra = ", \"d_try_multiplier\": " + sc::json_number(settings.d_try_multiplier) +
+                                  ", \"tol\": " + sc::json_number(*settings.tol);
+        char label[64];
+        std::snprintf(label, sizeof label, "  (d_try x %g, TOL %g)", settings.d_try_multiplier, *settings.tol);
+        sink.line(step_json(o, scene, phi, c, extra, r), progress(r, phi, c) + label);
+      }
+  }
+  deviations.erase({0, 2});  // the reference itself
+  print_table1(o, deviations, sink);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  try {
+    o = parse(argc, argv);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "fig4_spheres: %s\n%s", e.what(), kUsage);
+    return 2;
+  }
+  try {
+    ex::SphereMobility mobility = ex::make_mobility(o.mobility, o.spheres);
+    std::visit([&](auto& m) { o.table1 ? run_table1(o, m) : run_fig4(o, m); }, mobility);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fig4_spheres: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
