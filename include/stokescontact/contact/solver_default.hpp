@@ -36,6 +36,9 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/delassus_probing.hpp"
 #include "stokescontact/contact/lcp_minimum_map_newton.hpp"
@@ -67,6 +70,18 @@ double largest_bounding_radius(std::span<const S> shapes) {
   double r = 0.0;
   for (const S& s : shapes) r = std::max(r, bounding_radius(s));
   return r;
+}
+
+// The nearest matrix to the symmetric A~ whose eigenvalues are >= floor x its largest (A~
+// itself when it is positive definite). The true A = dt D^T M D is positive semi-definite, and
+// singular when the contacts outnumber the bodies' degrees of freedom (dense packings);
+// probing errors can then make A~ indefinite, and its LCP unsolvable.
+inline MatX positive_definite(const MatX& A, double floor = 1e-3) {
+  if (A.size() == 0 || Eigen::LLT<MatX>(A).info() == Eigen::Success) return A;
+  const Eigen::SelfAdjointEigenSolver<MatX> eigen(A);
+  const VecX& values = eigen.eigenvalues();
+  const double smallest = floor * values.maxCoeff();
+  return eigen.eigenvectors() * values.cwiseMax(smallest).asDiagonal() * eigen.eigenvectors().transpose();
 }
 
 // The working set's LCP of the linear model about the current iterate (A: the model's matrix
@@ -105,6 +120,7 @@ ContactSolveOutcome solve_default_round(ContactStep<S, M>& step, VecX lambda, co
     joining.push_back(k);
   };
   VecX previous_lambda, previous_distances;
+  MatX probed;  // positive_definite(probing.matrix()), recomputed when the working set grows
   double previous_shortfall = std::numeric_limits<double>::infinity();
   for (;;) {
     const ContactEvaluation& e = step.evaluate(lambda);
@@ -126,10 +142,12 @@ ContactSolveOutcome solve_default_round(ContactStep<S, M>& step, VecX lambda, co
     for (;;) {
       probing.add(step, joining);
       const std::vector<Eigen::Index>& W = probing.members();
-      // The secant-corrected model is not symmetric; should its LCP fail, the probed one is.
+      // The secant-corrected model is not symmetric; should its LCP fail, the probed one (made
+      // positive definite) is a strictly convex QP.
+      if (probed.rows() != static_cast<Eigen::Index>(W.size())) probed = positive_definite(probing.matrix());
       std::optional<VecX> solved =
-          solve_working_set_lcp(secant.corrected(probing.matrix(), W), W, lambda, e.distances, target, options.lcp);
-      if (!solved) solved = solve_working_set_lcp(probing.matrix(), W, lambda, e.distances, target, options.lcp);
+          solve_working_set_lcp(secant.corrected(probed, W), W, lambda, e.distances, target, options.lcp);
+      if (!solved) solved = solve_working_set_lcp(probed, W, lambda, e.distances, target, options.lcp);
       if (!solved) {
         out.message = "default solver: the working-set LCP (" + std::to_string(W.size()) + " pairs) did not converge";
         out.lambda = std::move(lambda);
