@@ -10,6 +10,8 @@
 #include "common/test_support.hpp"
 #include "stokescontact/contact/delassus_probing.hpp"
 #include "stokescontact/contact/secant_update.hpp"
+#include "stokescontact/contact/solver_default.hpp"
+#include "stokescontact/contact/solver_lcp_sequence.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/rpy_mobility.hpp"
 
@@ -133,6 +135,56 @@ TEST(SecantCorrection, HonoursEverySecantAndKeepsA0Elsewhere) {
   EXPECT_LE((corrected * orthogonal - A0_W * orthogonal).norm(), 1e-12);
   secant.clear();
   EXPECT_EQ(secant.corrected(A0_W, rows), A0_W);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(PositiveDefinite, KeepsADefiniteMatrixAndLiftsAnIndefiniteOne) {
+  sc::MatX A(3, 3);
+  A << 2, 1, 0, 1, 2, 0, 0, 0, 1;
+  EXPECT_EQ(sc::detail::positive_definite(A), A);
+  sc::MatX B(2, 2);
+  B << 1, 2, 2, 1;  // eigenvalues 3 and -1, eigenvectors (1, 1) and (1, -1) / sqrt 2
+  const sc::MatX lifted = sc::detail::positive_definite(B, 1e-3);
+  sc::MatX expected(2, 2);
+  expected << 1.5 + 1.5e-3, 1.5 - 1.5e-3, 1.5 - 1.5e-3, 1.5 + 1.5e-3;  // eigenvalues 3 and 3e-3
+  EXPECT_LE((lifted - expected).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+// A hard case: a simple-cubic lattice (5^3 spheres, gaps 0.01, phi ~ 0.52) squeezed towards
+// its centre, RPY mobility, matrix free: hundreds of contacts in one cluster, where probes
+// cannot be shared much and the probed model may be indefinite. The default must separate it
+// at complementarity, with no more force than the LCP sequence (which stops at its first
+// separated iterate and overshoots).
+TEST(DefaultSolver, SqueezedLatticeIsSeparatedAtComplementarity) {
+  std::vector<sc::Pose> poses;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      for (int k = 0; k < 5; ++k) poses.push_back({2.01 * sc::Vec3(i, j, k), sc::Quat::Identity()});
+  std::mt19937_64 rng(5);
+  sc::VecX U(3 * static_cast<Eigen::Index>(poses.size()));
+  for (std::size_t b = 0; b < poses.size(); ++b)
+    U.segment<3>(3 * static_cast<Eigen::Index>(b)) =
+        -2.0 * (poses[b].x - sc::Vec3::Constant(4.02)) + test_support::random_unit_vector(rng);
+  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  const sc::ContactStepProblem<sc::Sphere> p{shapes, poses, &U, 0.01, 0.005, 0.0, 1.0, {}};
+  sc::ContactStepOptions options;
+  options.cost = sc::MobilityCost::matrix_free;
+  sc::RpyMobility m1(poses.size(), sc::RpyParameters{1.0, 1.0}, 3), m2 = m1;
+  const sc::ContactStepResult def = sc::solve_contact_step_default(p, m1, options);
+  const sc::ContactStepResult lcp = sc::solve_contact_step_lcp_sequence(p, m2, options);
+  for (const sc::ContactStepResult* r : {&def, &lcp})
+    std::printf("[lattice] status %d Nc %zu apps %zu iters %d sum %.6f min d/d_hat %.9f compl %.2e\n",
+                static_cast<int>(r->status), r->flagged_pairs, r->mobility_applications, r->iterations, r->lambda_sum,
+                r->min_distance_ratio, r->complementarity_residual);
+  EXPECT_EQ(def.status, sc::ContactStepStatus::converged) << def.message;
+  EXPECT_GE(def.flagged_pairs, 200u);
+  EXPECT_GE(def.min_distance_ratio, 1.0 - 1e-9);
+  EXPECT_LE(def.complementarity_residual, 1e-3);
+  EXPECT_EQ(lcp.status, sc::ContactStepStatus::converged) << lcp.message;
+  EXPECT_LE(def.lambda_sum, lcp.lambda_sum * (1.0 + 1e-3));
 }
 
 }  // namespace

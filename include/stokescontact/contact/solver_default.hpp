@@ -43,6 +43,7 @@
 #include "stokescontact/contact/delassus_probing.hpp"
 #include "stokescontact/contact/lcp_minimum_map_newton.hpp"
 #include "stokescontact/contact/secant_update.hpp"
+#include "stokescontact/contact/solver_lcp_sequence.hpp"
 
 namespace stokescontact {
 
@@ -51,12 +52,16 @@ struct DefaultSolverOptions {
   double tol = 1e-4;                  // eq. 29 rule on successive corrections
   double probe_radius_factor = 4.0;   // probe radius = factor x the largest bounding radius
   int max_iterations = 50;            // corrections per round
+  double contraction = 0.5;           // a correction must shrink the shortfall by this factor ...
+                                      // ... or, twice in a row, the LCP sequence takes over
   LcpOptions lcp{1e-12};              // each small LCP's stopping rule
 
   void validate() const {
     require_non_negative(margin, "DefaultSolverOptions.margin");
     require_positive(tol, "DefaultSolverOptions.tol");
     require_positive(probe_radius_factor, "DefaultSolverOptions.probe_radius_factor");
+    if (!(contraction > 0.0 && contraction <= 1.0))
+      fail_argument("DefaultSolverOptions.contraction", "must lie in (0, 1], got " + std::to_string(contraction));
     if (max_iterations < 1)
       fail_argument("DefaultSolverOptions.max_iterations", "must be >= 1, got " + std::to_string(max_iterations));
     lcp.validate();
@@ -103,6 +108,21 @@ inline std::optional<VecX> solve_working_set_lcp(const MatX& A, std::span<const 
   return next;
 }
 
+// The fallback of a round whose corrections do not contract.
+template <Shape S, MobilityOperator M>
+ContactSolveOutcome finish_by_lcp_sequence(ContactStep<S, M>& step, const VecX& lambda, int corrections,
+                                           const DefaultSolverOptions& options) {
+  LcpSequenceOptions sequence;
+  sequence.tol = options.tol;  // on to complementarity, as the corrections would have
+  sequence.margin = options.margin;
+  ContactSolveOutcome out = solve_lcp_sequence_round(step, lambda, sequence);
+  out.message = "default solver: probing did not contract after " + std::to_string(corrections) +
+                " corrections, finished by the LCP sequence (" + std::to_string(out.iterations) + " LCPs)" +
+                (out.message.empty() ? "" : ": " + out.message);
+  out.iterations += corrections;
+  return out;
+}
+
 // One round from the warm start (the previous round's lambda, zero-padded).
 template <Shape S, MobilityOperator M>
 ContactSolveOutcome solve_default_round(ContactStep<S, M>& step, VecX lambda, const DefaultSolverOptions& options) {
@@ -122,6 +142,9 @@ ContactSolveOutcome solve_default_round(ContactStep<S, M>& step, VecX lambda, co
   VecX previous_lambda, previous_distances;
   MatX probed;  // positive_definite(probing.matrix()), recomputed when the working set grows
   double previous_shortfall = std::numeric_limits<double>::infinity();
+  double best_shortfall = std::numeric_limits<double>::infinity();
+  VecX best_lambda = lambda;
+  int slow_corrections = 0;
   for (;;) {
     const ContactEvaluation& e = step.evaluate(lambda);
     // The working set: every pair below the target or pushed...
@@ -137,6 +160,18 @@ ContactSolveOutcome solve_default_round(ContactStep<S, M>& step, VecX lambda, co
     } else if (out.iterations > 1) {
       secant.add(lambda - previous_lambda, e.distances - previous_distances);
     }
+    // Probes shared by contacts whose coupling is not small (large dense clusters, where the
+    // far fields of many contacts add up) give a model too poor to contract: after two
+    // corrections that did not halve the shortfall, the round is finished by the LCP sequence
+    // with exact (matrix-free) products, from the best iterate.
+    if (shortfall < best_shortfall) {
+      best_shortfall = shortfall;
+      best_lambda = lambda;
+    }
+    // (With every probe a single contact the model is exact, and slowness is the geometry's.)
+    const bool shared_probes = probing.probes() < static_cast<int>(probing.members().size());
+    slow_corrections = shared_probes && shortfall > options.contraction * previous_shortfall ? slow_corrections + 1 : 0;
+    if (slow_corrections == 2) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options);
     previous_shortfall = shortfall;
     VecX next;
     for (;;) {
