@@ -247,18 +247,10 @@ void run_table1(const Options& o, M& mobility) {
 
 int main(int argc, char** argv) {
   Options o;
-  try {
-    o = parse(argc, argv);
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "fig4_spheres: %s\n%s", e.what(), kUsage);
-    return 2;
-  }
-  try {
-    ex::SphereMobility mobility = ex::make_mobility(o.mobility, o.spheres);
-    std::visit([&](auto& m) { o.table1 ? run_table1(o, m) : run_fig4(o, m); }, mobility);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "fig4_spheres: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  return ex::driver_main(
+      "fig4_spheres", kUsage, [&] { o = parse(argc, argv); },
+      [&] {
+        ex::SphereMobility mobility = ex::make_mobility(o.mobility, o.spheres);
+        std::visit([&](auto& m) { o.table1 ? run_table1(o, m) : run_fig4(o, m); }, mobility);
+      });
 }

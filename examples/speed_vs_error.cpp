@@ -219,17 +219,5 @@ void run(const Options& o) {
 
 int main(int argc, char** argv) {
   Options o;
-  try {
-    o = parse(argc, argv);
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "speed_vs_error: %s\n%s", e.what(), kUsage);
-    return 2;
-  }
-  try {
-    run(o);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "speed_vs_error: %s\n", e.what());
-    return 1;
-  }
-  return 0;
+  return ex::driver_main("speed_vs_error", kUsage, [&] { o = parse(argc, argv); }, [&] { run(o); });
 }

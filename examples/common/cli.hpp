@@ -183,4 +183,23 @@ inline double maximum(const std::vector<double>& v) {
   return v.empty() ? std::numeric_limits<double>::quiet_NaN() : *std::max_element(v.begin(), v.end());
 }
 
+// A driver's main: `parse` throwing std::invalid_argument prints the error and the usage
+// (exit 2), `run` throwing anything prints the error (exit 1).
+template <typename Parse, typename Run>
+int driver_main(const char* name, const char* usage, Parse&& parse, Run&& run) {
+  try {
+    parse();
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "%s: %s\n%s", name, e.what(), usage);
+    return 2;
+  }
+  try {
+    run();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", name, e.what());
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace examples
