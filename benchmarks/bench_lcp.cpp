@@ -22,9 +22,9 @@
 
 #include <Eigen/Sparse>
 
-#include "stokescontact/contact/lcp_apgd.hpp"
-#include "stokescontact/contact/lcp_bbpgd.hpp"
-#include "stokescontact/contact/lcp_minimum_map_newton.hpp"
+#include "stokescontact/lcp/apgd.hpp"
+#include "stokescontact/lcp/bbpgd.hpp"
+#include "stokescontact/lcp/minimum_map_newton.hpp"
 
 namespace {
 

@@ -6,9 +6,9 @@
 //   default                                     the library's default solver
 // solve() runs an entry on one contact step; an optional TOL (the eq. 29 stopping rule)
 // replaces the solver's own where it has one (barrier, default); the LCP solvers have none.
-#include <stokescontact/contact/solver_barrier_nlopt.hpp>
-#include <stokescontact/contact/solver_default.hpp>
-#include <stokescontact/contact/solver_lcp_sequence.hpp>
+#include <stokescontact/contact/solvers/barrier_nlopt.hpp>
+#include <stokescontact/contact/solvers/defect_correction.hpp>
+#include <stokescontact/contact/solvers/lcp_sequence.hpp>
 
 #include <optional>
 #include <stdexcept>
@@ -21,7 +21,7 @@ namespace examples {
 
 namespace sc = stokescontact;
 
-struct DefaultSolver {};  // solve_contact_step_default with its own options
+struct DefaultSolver {};  // solve_contact_step_defect_correction with its own options
 
 struct SolverEntry {
   std::string name;
@@ -74,9 +74,9 @@ sc::ContactStepResult solve(const SolverEntry& entry, const sc::ContactStepProbl
           sequence.inner = kind;
           return sc::solve_contact_step_lcp_sequence(problem, mobility, options, sequence);
         } else {
-          sc::DefaultSolverOptions solver;
+          sc::DefectCorrectionOptions solver;
           if (tol) solver.tol = *tol;
-          return sc::solve_contact_step_default(problem, mobility, options, solver);
+          return sc::solve_contact_step_defect_correction(problem, mobility, options, solver);
         }
       },
       entry.kind);

@@ -196,7 +196,7 @@ template <sc::MobilityOperator M>
 StepRecord run_step(const SolverEntry& solver, const SphereScene& scene, M& mobility, const sc::VecX& U,
                     const StepSettings& settings) {
   const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
-  const sc::ContactStepProblem<sc::Sphere> problem{shapes, scene.packing.poses, &U, kTimeStep, scene.d_hat,
+  const sc::ContactStepProblem<sc::Sphere> problem{shapes, scene.packing.poses, U, kTimeStep, scene.d_hat,
                                                    0.0,    settings.d_try_multiplier, {}};
   const sc::ContactStepResult r = solve(solver, problem, mobility, settings.options, settings.tol);
   const int dofs = mobility.dofs_per_body();

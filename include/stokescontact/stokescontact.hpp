@@ -15,6 +15,7 @@
 #include "stokescontact/geometry/centre_curve.hpp"
 #include "stokescontact/geometry/closest_points.hpp"
 #include "stokescontact/geometry/mass_tensors.hpp"
+#include "stokescontact/geometry/periodic_box.hpp"
 #include "stokescontact/geometry/point_distance.hpp"
 #include "stokescontact/geometry/primitives.hpp"
 #include "stokescontact/geometry/segment_distance.hpp"
@@ -39,23 +40,30 @@
 #include "stokescontact/mobility/single_body_mobility.hpp"
 #include "stokescontact/mobility/sphere_shell.hpp"
 
-// contact
+// lcp (needs only core)
+#include "stokescontact/lcp/apgd.hpp"
+#include "stokescontact/lcp/bbpgd.hpp"
+#include "stokescontact/lcp/lcp.hpp"
+#include "stokescontact/lcp/minimum_map_newton.hpp"
+
+// contact: detection, the contact matrix, the contact step
 #include "stokescontact/contact/barrier.hpp"
 #include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/contact/contact_pairs.hpp"
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/d_try.hpp"
-#include "stokescontact/contact/delassus_probing.hpp"
-#include "stokescontact/contact/lcp.hpp"
-#include "stokescontact/contact/lcp_apgd.hpp"
-#include "stokescontact/contact/lcp_bbpgd.hpp"
-#include "stokescontact/contact/lcp_minimum_map_newton.hpp"
 #include "stokescontact/contact/scene.hpp"
-#include "stokescontact/contact/secant_update.hpp"
-#include "stokescontact/contact/solver_barrier_nlopt.hpp"
-#include "stokescontact/contact/solver_default.hpp"
-#include "stokescontact/contact/solver_lcp_sequence.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
+
+// contact/solvers: the contact-step solvers and the choice among them
+#include "stokescontact/contact/solvers/contact_solver.hpp"
+#include "stokescontact/contact/solvers/defect_correction.hpp"
+#include "stokescontact/contact/solvers/delassus_probing.hpp"
+#include "stokescontact/contact/solvers/lcp_sequence.hpp"
+#include "stokescontact/contact/solvers/secant_update.hpp"
+#if STOKESCONTACT_HAS_NLOPT
+#include "stokescontact/contact/solvers/barrier_nlopt.hpp"
+#endif
 
 // dynamics
 #include "stokescontact/dynamics/background_flow.hpp"

@@ -16,9 +16,9 @@
 
 #include "contact/random_scenes.hpp"
 #include "stokescontact/contact/contact_step.hpp"
-#include "stokescontact/contact/solver_barrier_nlopt.hpp"
-#include "stokescontact/contact/solver_default.hpp"
-#include "stokescontact/contact/solver_lcp_sequence.hpp"
+#include "stokescontact/contact/solvers/barrier_nlopt.hpp"
+#include "stokescontact/contact/solvers/defect_correction.hpp"
+#include "stokescontact/contact/solvers/lcp_sequence.hpp"
 #include "stokescontact/geometry/closest_points.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 
@@ -43,7 +43,7 @@ sc::ContactStepResult solve(Solver s, const sc::ContactStepProblem<S>& p, sc::Fr
   switch (s) {
     case Solver::kLcpSequence: return sc::solve_contact_step_lcp_sequence(p, m);
     case Solver::kBarrierSlsqp: return sc::solve_contact_step_barrier(p, m);
-    case Solver::kDefault: return sc::solve_contact_step_default(p, m);
+    case Solver::kDefault: return sc::solve_contact_step_defect_correction(p, m);
   }
   return {};
 }
@@ -95,16 +95,16 @@ void check_pair_across_the_boundary(const PairCase<S>& c) {
   {
     sc::FreeDrainingMobility m(n, 2, c.dofs);
     const sc::ContactStepResult open = sc::solve_contact_step_lcp_sequence(
-        sc::ContactStepProblem<S>{shapes, periodic_poses, &c.U, dt, d_hat, 0.0, 1.0, {}}, m);
+        sc::ContactStepProblem<S>{shapes, periodic_poses, c.U, dt, d_hat, 0.0, 1.0, {}}, m);
     EXPECT_EQ(open.flagged_pairs, 0u);
   }
   for (const Solver solver : kSolvers) {
     SCOPED_TRACE(c.label + " " + name(solver));
     sc::FreeDrainingMobility m_periodic(n, 2, c.dofs), m_middle(n, 2, c.dofs);
     const sc::ContactStepResult r =
-        solve(solver, sc::ContactStepProblem<S>{shapes, periodic_poses, &c.U, dt, d_hat, 0.0, 1.0, box}, m_periodic);
+        solve(solver, sc::ContactStepProblem<S>{shapes, periodic_poses, c.U, dt, d_hat, 0.0, 1.0, box}, m_periodic);
     const sc::ContactStepResult ref =
-        solve(solver, sc::ContactStepProblem<S>{shapes, middle_poses, &c.U, dt, d_hat, 0.0, 1.0, {}}, m_middle);
+        solve(solver, sc::ContactStepProblem<S>{shapes, middle_poses, c.U, dt, d_hat, 0.0, 1.0, {}}, m_middle);
     ASSERT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
     ASSERT_EQ(ref.status, sc::ContactStepStatus::converged) << ref.message;
     ASSERT_EQ(r.flagged_pairs, 1u);
@@ -195,7 +195,7 @@ TEST(ContactStepPeriodic, RandomSpheresInABoxEndSeparated) {
     sc::VecX U(3 * static_cast<Eigen::Index>(poses.size()));
     for (Eigen::Index b = 0; b < U.size(); b += 3) U.segment<3>(b) = 5.0 * random_unit_vector(rng);
     const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
-    const sc::ContactStepProblem<sc::Sphere> problem{shapes, poses, &U, dt, d_hat, 0.0, 1.0,
+    const sc::ContactStepProblem<sc::Sphere> problem{shapes, poses, U, dt, d_hat, 0.0, 1.0,
                                                      sc::PeriodicBox{sc::Vec3::Constant(L)}};
     const double before = min_distance_over_images(sc::Sphere{1.0}, poses, L);
     for (const Solver solver : kSolvers) {

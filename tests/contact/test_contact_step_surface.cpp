@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "contact/random_scenes.hpp"
-#include "stokescontact/contact/solver_barrier_nlopt.hpp"
-#include "stokescontact/contact/solver_default.hpp"
-#include "stokescontact/contact/solver_lcp_sequence.hpp"
+#include "stokescontact/contact/solvers/barrier_nlopt.hpp"
+#include "stokescontact/contact/solvers/defect_correction.hpp"
+#include "stokescontact/contact/solvers/lcp_sequence.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 #include "stokescontact/mobility/boomerang_blobs.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
@@ -36,7 +36,7 @@ TEST(ContactStepSurface, AlignedSpheresMatchTheClosedForm) {
   U << 0, 0, 10, 0, 0, -10;
   const double dt = 0.01, d_hat = 0.01, mu = 1.0 / (6.0 * std::numbers::pi);
   const double lambda_star = (d_hat - (0.1 - 2.0 * 10.0 * dt)) / (2.0 * mu * dt);
-  const sc::ContactStepProblem<sc::Sphere> p{shapes, poses, &U, dt, d_hat, 0.0, 1.0, {}};
+  const sc::ContactStepProblem<sc::Sphere> p{shapes, poses, U, dt, d_hat, 0.0, 1.0, {}};
   sc::ContactStepOptions options;
   options.directions = sc::ContactDirections::surface;
   options.node_spacing = 0.1;
@@ -90,13 +90,13 @@ TEST(ContactStepSurface, BoomerangsDefaultToSurfaceNodesAndSeparate) {
   for (const std::uint64_t seed : {41u, 42u}) {
     const BoomerangScene s = random_boomerangs(seed, 14, 5.0);
     const std::vector<sc::Boomerang> shapes{s.shape};
-    const sc::ContactStepProblem<sc::Boomerang> p{shapes, s.poses, &s.U, 0.01, 0.02, 0.0, 1.0, {}};
+    const sc::ContactStepProblem<sc::Boomerang> p{shapes, s.poses, s.U, 0.01, 0.02, 0.0, 1.0, {}};
     const auto mobility = [&] { return sc::FreeDrainingMobility(s.body_mobility, s.poses.size(), 6); };
     sc::ContactStepOptions particle;
     particle.directions = sc::ContactDirections::particle;
     auto m0 = mobility(), m1 = mobility(), m2 = mobility(), m3 = mobility();
-    const sc::ContactStepResult by_default = sc::solve_contact_step_default(p, m0);
-    const sc::ContactStepResult by_particle = sc::solve_contact_step_default(p, m1, particle);
+    const sc::ContactStepResult by_default = sc::solve_contact_step_defect_correction(p, m0);
+    const sc::ContactStepResult by_particle = sc::solve_contact_step_defect_correction(p, m1, particle);
     const sc::ContactStepResult lcp = sc::solve_contact_step_lcp_sequence(p, m2);
     const sc::ContactStepResult barrier = sc::solve_contact_step_barrier(p, m3);
     // D acts at the trial step Q* (eq. 16): the torques balance about its centres.
@@ -123,11 +123,11 @@ TEST(ContactStepSurface, BoomerangsDefaultToSurfaceNodesAndSeparate) {
 TEST(ContactStepSurface, RejectsANegativeNodeSpacing) {
   const BoomerangScene s = random_boomerangs(43u, 2, 6.0);
   const std::vector<sc::Boomerang> shapes{s.shape};
-  const sc::ContactStepProblem<sc::Boomerang> p{shapes, s.poses, &s.U, 0.01, 0.02, 0.0, 1.0, {}};
+  const sc::ContactStepProblem<sc::Boomerang> p{shapes, s.poses, s.U, 0.01, 0.02, 0.0, 1.0, {}};
   sc::FreeDrainingMobility m(s.body_mobility, 2, 6);
   sc::ContactStepOptions options;
   options.node_spacing = -0.1;
-  test_support::expect_rejects([&] { (void)sc::solve_contact_step_default(p, m, options); },
+  test_support::expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(p, m, options); },
                                "ContactStepOptions.node_spacing");
 }
 

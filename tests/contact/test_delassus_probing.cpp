@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "common/test_support.hpp"
-#include "stokescontact/contact/delassus_probing.hpp"
-#include "stokescontact/contact/secant_update.hpp"
-#include "stokescontact/contact/solver_default.hpp"
-#include "stokescontact/contact/solver_lcp_sequence.hpp"
+#include "stokescontact/contact/solvers/delassus_probing.hpp"
+#include "stokescontact/contact/solvers/secant_update.hpp"
+#include "stokescontact/contact/solvers/defect_correction.hpp"
+#include "stokescontact/contact/solvers/lcp_sequence.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/rpy_mobility.hpp"
 
@@ -30,7 +30,7 @@ struct TwoClusters {
       for (int k = 0; k < 3; ++k) poses.push_back({sc::Vec3(x0 + 2.01 * k, 0.3 * k, 0.0), sc::Quat::Identity()});
     U = sc::VecX::Zero(3 * static_cast<Eigen::Index>(poses.size()));
   }
-  sc::ContactStepProblem<sc::Sphere> problem() const { return {shapes, poses, &U, 0.01, 0.005, 0.05, 1.0, {}}; }
+  sc::ContactStepProblem<sc::Sphere> problem() const { return {shapes, poses, U, 0.01, 0.005, 0.05, 1.0, {}}; }
 };
 
 // dt D^T M D on the given contacts, one exact column per application.
@@ -169,11 +169,11 @@ TEST(DefaultSolver, SqueezedLatticeIsSeparatedAtComplementarity) {
     U.segment<3>(3 * static_cast<Eigen::Index>(b)) =
         -2.0 * (poses[b].x - sc::Vec3::Constant(4.02)) + test_support::random_unit_vector(rng);
   const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
-  const sc::ContactStepProblem<sc::Sphere> p{shapes, poses, &U, 0.01, 0.005, 0.0, 1.0, {}};
+  const sc::ContactStepProblem<sc::Sphere> p{shapes, poses, U, 0.01, 0.005, 0.0, 1.0, {}};
   sc::ContactStepOptions options;
   options.cost = sc::MobilityCost::matrix_free;
   sc::RpyMobility m1(poses.size(), sc::RpyParameters{1.0, 1.0}, 3), m2 = m1;
-  const sc::ContactStepResult def = sc::solve_contact_step_default(p, m1, options);
+  const sc::ContactStepResult def = sc::solve_contact_step_defect_correction(p, m1, options);
   const sc::ContactStepResult lcp = sc::solve_contact_step_lcp_sequence(p, m2, options);
   for (const sc::ContactStepResult* r : {&def, &lcp})
     std::printf("[lattice] status %d Nc %zu apps %zu iters %d sum %.6f min d/d_hat %.9f compl %.2e\n",

@@ -14,10 +14,10 @@
 
 #include <Eigen/Sparse>
 
-#include "stokescontact/contact/lcp.hpp"
-#include "stokescontact/contact/lcp_apgd.hpp"
-#include "stokescontact/contact/lcp_bbpgd.hpp"
-#include "stokescontact/contact/lcp_minimum_map_newton.hpp"
+#include "stokescontact/lcp/lcp.hpp"
+#include "stokescontact/lcp/apgd.hpp"
+#include "stokescontact/lcp/bbpgd.hpp"
+#include "stokescontact/lcp/minimum_map_newton.hpp"
 
 namespace sc = stokescontact;
 

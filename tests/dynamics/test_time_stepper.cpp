@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "common/test_support.hpp"
-#include "stokescontact/contact/solver_barrier_nlopt.hpp"
-#include "stokescontact/contact/solver_default.hpp"
-#include "stokescontact/contact/solver_lcp_sequence.hpp"
+#include "stokescontact/contact/solvers/barrier_nlopt.hpp"
+#include "stokescontact/contact/solvers/defect_correction.hpp"
+#include "stokescontact/contact/solvers/lcp_sequence.hpp"
 #include "stokescontact/dynamics/background_flow.hpp"
 #include "stokescontact/dynamics/time_stepper.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
@@ -47,9 +47,9 @@ const auto kBarrierSlsqp = [](const auto& problem, auto& mobility) {
   return sc::solve_contact_step_barrier(problem, mobility);
 };
 const auto kDefault = [](const auto& problem, auto& mobility) {
-  return sc::solve_contact_step_default(problem, mobility);
+  return sc::solve_contact_step_defect_correction(problem, mobility);
 };
-constexpr double kDefaultMargin = 1e-4;  // DefaultSolverOptions::margin
+constexpr double kDefaultMargin = 1e-4;  // DefectCorrectionOptions::margin
 
 sc::FreeDrainingMobility sphere_mobility(std::size_t n, int dofs) {
   return sc::FreeDrainingMobility(sc::sphere_mobility(sc::Sphere{1.0}, 1.0), n, dofs);

@@ -1,5 +1,8 @@
-# Installs StokesContact from BUILD_DIR into a scratch prefix and builds, then runs,
-# a separate project that finds it with find_package(stokescontact REQUIRED).
+# Installs StokesContact into a scratch prefix and builds, then runs, a separate project that
+# finds it with find_package(stokescontact REQUIRED).
+#   NLOPT=ON:  installs BUILD_DIR (the project's own build, with NLopt);
+#   NLOPT=OFF: configures the library alone from SOURCE_DIR with STOKESCONTACT_USE_NLOPT=OFF
+#              and installs that: the consumer must build and run without NLopt's target.
 file(REMOVE_RECURSE ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
 
@@ -11,9 +14,23 @@ function(run_step)
   message(STATUS "${out}")
 endfunction()
 
-run_step(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+if(NLOPT)
+  set(install_from ${BUILD_DIR})
+  set(expect 1)
+else()
+  set(install_from ${WORK_DIR}/library)
+  run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${install_from} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+           -DSTOKESCONTACT_USE_NLOPT=OFF -DSTOKESCONTACT_BUILD_TESTS=OFF
+           -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF -DSTOKESCONTACT_BUILD_EXAMPLES=OFF)
+  set(expect 0)
+endif()
+run_step(${CMAKE_COMMAND} --install ${install_from} --prefix ${prefix})
+file(READ ${prefix}/share/stokescontact/cmake/stokescontactTargets.cmake targets)
+if(NOT NLOPT AND targets MATCHES "nlopt")
+  message(FATAL_ERROR "the package configured without NLopt still names it:\n${targets}")
+endif()
 run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/package/consumer -B ${WORK_DIR}/build
          -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-         -DCMAKE_BUILD_TYPE=Release)
+         -DCMAKE_BUILD_TYPE=Release -DEXPECT_NLOPT=${expect})
 run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run_step(${WORK_DIR}/build/consumer)

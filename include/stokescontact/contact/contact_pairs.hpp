@@ -30,15 +30,6 @@ struct ContactPair {
   ClosestPoints points;
 };
 
-// The lattice vector that takes x_j to its image nearest x_i (zero without a box).
-inline Vec3 minimum_image_shift(const Vec3& x_i, const Vec3& x_j, const std::optional<PeriodicBox>& box) {
-  if (!box) return Vec3::Zero();
-  const Vec3 d = x_j - x_i;
-  Vec3 shift;
-  for (int k = 0; k < 3; ++k) shift[k] = -box->lengths[k] * std::round(d[k] / box->lengths[k]);
-  return shift;
-}
-
 inline Pose shifted(const Pose& pose, const Vec3& shift) { return {pose.x + shift, pose.q}; }
 
 namespace detail {

@@ -32,7 +32,6 @@
 #include <span>
 #include <sstream>
 #include <string>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -53,19 +52,19 @@ template <Shape S>
 struct ContactStepProblem {
   std::span<const S> shapes;         // one per body, or one shared
   std::span<const Pose> poses;       // Q_t, contact free (every d^P >= 0)
-  const VecX* U = nullptr;           // unconstrained velocities, N * mobility.dofs_per_body()
+  const VecX& U;                     // unconstrained velocities, N * mobility.dofs_per_body()
   double dt = 0.0;                   // > 0
   double d_hat = 0.0;                // > 0, the smallest distance allowed at t + dt
   double d_try = 0.0;                // 0: eq. 31 (dofs 3) or eq. 30 (dofs 6) times the multiplier;
                                      // > 0: used as given (>= d_hat), the multiplier ignored
   double d_try_multiplier = 1.0;     // >= 1
-  std::optional<PeriodicBox> box;    // periodic box, none for open space
+  std::optional<PeriodicBox> box = std::nullopt;  // periodic box, none for open space
 };
 
 enum class MobilityCost { formed, matrix_free };
 
 // Where contact forces act: the closest points (eq. 21) or the surface-node pairs (eq. 23);
-// automatic: surface for boomerangs, particle for the convex shapes.
+// automatic: surface for non-convex shapes (boomerangs), particle for convex ones.
 enum class ContactDirections { automatic, particle, surface };
 
 struct ContactStepOptions {
@@ -92,8 +91,7 @@ struct ContactStepOptions {
   // Whether a scene of shape S uses d^S for its contact directions.
   template <Shape S>
   bool surface_directions() const {
-    return directions == ContactDirections::surface ||
-           (directions == ContactDirections::automatic && std::is_same_v<S, Boomerang>);
+    return directions == ContactDirections::surface || (directions == ContactDirections::automatic && !S::convex);
   }
 };
 
@@ -154,9 +152,8 @@ class ContactStep {
     validate_scene(problem.shapes, problem.poses);
     require_positive(problem.dt, "dt");
     require_positive(problem.d_hat, "d_hat");
-    if (problem.U == nullptr) fail_argument("U", "must be given");
     dofs_ = mobility.dofs_per_body();
-    detail::require_velocities(*problem.U, problem.poses.size(), dofs_);
+    detail::require_velocities(problem.U, problem.poses.size(), dofs_);
     if (mobility.size() != static_cast<Eigen::Index>(problem.poses.size()) * dofs_)
       fail_argument("mobility", "has size " + std::to_string(mobility.size()) + ", expected " +
                                     std::to_string(problem.poses.size() * static_cast<std::size_t>(dofs_)));
@@ -167,8 +164,8 @@ class ContactStep {
                                  std::to_string(start.j) + " overlap, d = " + std::to_string(start.distance));
     d_try_ = problem.d_try;
     if (d_try_ == 0.0) {
-      d_try_ = dofs_ == 3 ? d_try_spheres(problem.d_hat, problem.dt, *problem.U, 3, problem.d_try_multiplier)
-                          : d_try_tip_velocity(problem.d_hat, problem.dt, problem.shapes, problem.poses, *problem.U,
+      d_try_ = dofs_ == 3 ? d_try_spheres(problem.d_hat, problem.dt, problem.U, 3, problem.d_try_multiplier)
+                          : d_try_tip_velocity(problem.d_hat, problem.dt, problem.shapes, problem.poses, problem.U,
                                                problem.d_try_multiplier);
     } else {
       require_positive(d_try_, "d_try");
@@ -180,7 +177,7 @@ class ContactStep {
       for (const S& shape : problem.shapes)
         nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : 0.5 * shape.radius));
     }
-    trial_ = advance_all(*problem.U);  // eq. 16
+    trial_ = advance_all(problem.U);  // eq. 16
     pairs_ = find_contact_pairs(problem.shapes, std::span<const Pose>(trial_), d_try_, problem.box);
     rebuild();
     // Everything checked: only now touch the mobility.
@@ -230,7 +227,7 @@ class ContactStep {
     ContactEvaluation e;
     e.lambda = lambda;
     e.MD_lambda = MD_times(lambda);
-    e.poses = advance_all(*problem_.U + e.MD_lambda);
+    e.poses = advance_all(problem_.U + e.MD_lambda);
     e.pairs.reserve(pairs_.size());
     e.distances.resize(nc());
     for (std::size_t k = 0; k < pairs_.size(); ++k) {
@@ -365,7 +362,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   r.pairs = step.pairs();
   r.flagged_pairs = r.pairs.size();
   r.contact_forces = step.D() * r.lambda;
-  r.velocities = *problem.U + e.MD_lambda;
+  r.velocities = problem.U + e.MD_lambda;
   r.poses = e.poses;
   r.d_try = step.d_try();
   r.min_distance_ratio =

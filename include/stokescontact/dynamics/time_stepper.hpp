@@ -191,7 +191,7 @@ class TimeStepper {
       applications = 1;
     }
     // Eq. 13/16 through the user's solver.
-    const ContactStepProblem<S> problem{std::span<const S>(shapes_), q_t,     &U, options_.dt, options_.d_hat,
+    const ContactStepProblem<S> problem{std::span<const S>(shapes_), q_t, U, options_.dt, options_.d_hat,
                                         options_.d_try,              options_.d_try_multiplier, options_.box};
     ContactStepResult result = solver_(problem, mobility_);
     if (result.status == ContactStepStatus::failed_separation)

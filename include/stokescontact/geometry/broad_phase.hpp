@@ -15,13 +15,9 @@
 
 #include "stokescontact/core/errors.hpp"
 #include "stokescontact/core/types.hpp"
+#include "stokescontact/geometry/periodic_box.hpp"
 
 namespace stokescontact {
-
-// The box [0, Lx) x [0, Ly) x [0, Lz), repeated periodically.
-struct PeriodicBox {
-  Vec3 lengths = Vec3::Ones();
-};
 
 // A candidate pair, i < j.
 struct BodyPair {
@@ -29,18 +25,6 @@ struct BodyPair {
   Eigen::Index j = 0;
   friend auto operator<=>(const BodyPair&, const BodyPair&) = default;
 };
-
-// x mapped into [0, length). fmod is exact, so only the shift of a negative remainder rounds.
-inline double wrap_coordinate(double x, double length) {
-  double r = std::fmod(x, length);
-  if (r < 0.0) r += length;
-  return r < length ? r : 0.0;  // -tiny + length may round up to length, i.e. 0 in the box
-}
-
-inline Vec3 wrap_into_box(const Vec3& x, const PeriodicBox& box) {
-  return {wrap_coordinate(x.x(), box.lengths.x()), wrap_coordinate(x.y(), box.lengths.y()),
-          wrap_coordinate(x.z(), box.lengths.z())};
-}
 
 namespace detail {
 // floor for |v| < 2^62, inline (std::floor is a library call without SSE4.1).

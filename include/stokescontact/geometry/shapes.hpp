@@ -10,13 +10,18 @@
 
 namespace stokescontact {
 
+// Each shape says whether it is convex: a convex pair touches at one place, so the closest
+// points (d^P, Broms & Tornberg eq. 21) give its contact direction; a non-convex pair may touch
+// at several, and the contact step spreads its force over surface-node pairs (d^S, eq. 23).
 struct Sphere {
+  static constexpr bool convex = true;
   double radius = 1.0;
 };
 
 // Yan et al. Appendix A: a cylinder whose centre segment has length `length` (L) along the
 // body z axis, capped by hemispheres of radius `radius` (R).
 struct Spherocylinder {
+  static constexpr bool convex = true;
   double length = 1.0;
   double radius = 0.5;
 };
@@ -26,6 +31,7 @@ struct Spherocylinder {
 // hemispherical cap. The paper's particle (a rod of end-to-end length 4 and radius 0.5
 // cut in two and joined about the touching corner) is broms_tornberg_boomerang().
 struct Boomerang {
+  static constexpr bool convex = false;
   double arm_length = 1.5;
   double radius = 0.5;
   double bend_radius = 0.5;
@@ -119,6 +125,7 @@ inline double bounding_radius(const Boomerang& b) {
 template <typename S>
 concept Shape = requires(const S& s) {
   { s.radius } -> std::convertible_to<double>;
+  { S::convex } -> std::convertible_to<bool>;
   centre_curve(s);
   { bounding_radius(s) } -> std::convertible_to<double>;
   { volume(s) } -> std::convertible_to<double>;

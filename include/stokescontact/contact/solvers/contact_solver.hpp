@@ -1,0 +1,159 @@
+#pragma once
+// Choosing a contact solver by value, and `solve_contact_step`, the name users call.
+//
+// A `ContactSolver` is the options struct of one of the library's solvers; which alternative
+// it holds says which solver runs:
+//   DefectCorrectionOptions   the default: eq. 27 by defect correction (defect_correction.hpp)
+//   LcpSequenceOptions        the NCP as a sequence of LCPs (Lu et al. Alg. 1; lcp_sequence.hpp)
+//   BarrierNloptOptions       the barrier method, eq. 15 with NLopt (barrier_nlopt.hpp); only
+//                             where the library was configured with NLopt
+//                             (STOKESCONTACT_HAS_NLOPT)
+// Every solver returns the same ContactStepResult. Drivers and scene files name a solver by a
+// string (contact_solver_from_name): "default", "lcp-bbpgd", "lcp-apgd", "lcp-newton",
+// "barrier-slsqp", "barrier-mma", "barrier-cobyla".
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+#include "stokescontact/contact/solvers/defect_correction.hpp"
+#include "stokescontact/contact/solvers/lcp_sequence.hpp"
+#if STOKESCONTACT_HAS_NLOPT
+#include "stokescontact/contact/solvers/barrier_nlopt.hpp"
+#endif
+
+namespace stokescontact {
+
+using ContactSolver = std::variant<DefectCorrectionOptions, LcpSequenceOptions
+#if STOKESCONTACT_HAS_NLOPT
+                                   ,
+                                   BarrierNloptOptions
+#endif
+                                   >;
+
+namespace detail {
+
+struct NamedContactSolver {
+  std::string_view name;
+  ContactSolver (*make)();
+};
+
+template <InnerLcpSolver Inner>
+ContactSolver lcp_sequence_with() {
+  LcpSequenceOptions o;
+  o.inner = Inner;
+  return o;
+}
+
+#if STOKESCONTACT_HAS_NLOPT
+template <BarrierOptimizer Optimizer>
+ContactSolver barrier_with() {
+  BarrierNloptOptions o;
+  o.optimizer = Optimizer;
+  return o;
+}
+#endif
+
+inline constexpr std::array kNamedContactSolvers{
+    NamedContactSolver{"default", [] { return ContactSolver{DefectCorrectionOptions{}}; }},
+    NamedContactSolver{"lcp-bbpgd", &lcp_sequence_with<InnerLcpSolver::bbpgd>},
+    NamedContactSolver{"lcp-apgd", &lcp_sequence_with<InnerLcpSolver::apgd>},
+    NamedContactSolver{"lcp-newton", &lcp_sequence_with<InnerLcpSolver::minimum_map_newton>},
+#if STOKESCONTACT_HAS_NLOPT
+    NamedContactSolver{"barrier-slsqp", &barrier_with<BarrierOptimizer::slsqp>},
+    NamedContactSolver{"barrier-mma", &barrier_with<BarrierOptimizer::mma>},
+    NamedContactSolver{"barrier-cobyla", &barrier_with<BarrierOptimizer::cobyla>},
+#endif
+};
+
+}  // namespace detail
+
+// The names contact_solver_from_name knows, in a fixed order ("default" first).
+inline std::vector<std::string> contact_solver_names() {
+  std::vector<std::string> names;
+  for (const detail::NamedContactSolver& s : detail::kNamedContactSolvers) names.emplace_back(s.name);
+  return names;
+}
+
+// The solver called `name` with its default options; std::invalid_argument listing the known
+// names otherwise (a barrier name in a build without NLopt says so).
+inline ContactSolver contact_solver_from_name(std::string_view name) {
+  for (const detail::NamedContactSolver& s : detail::kNamedContactSolvers)
+    if (s.name == name) return s.make();
+  std::string known;
+  for (const std::string& n : contact_solver_names()) known += (known.empty() ? "" : ", ") + n;
+  std::string why = "unknown solver '" + std::string(name) + "' (known: " + known + ")";
+#if !STOKESCONTACT_HAS_NLOPT
+  if (name.starts_with("barrier-")) why += "; the barrier solvers need the library built with NLopt";
+#endif
+  fail_argument("solver", why);
+}
+
+// The name of a solver value, as contact_solver_from_name reads it.
+inline std::string contact_solver_name(const ContactSolver& solver) {
+  return std::visit(
+      [](const auto& o) -> std::string {
+        using O = std::decay_t<decltype(o)>;
+        if constexpr (std::is_same_v<O, DefectCorrectionOptions>) {
+          return "default";
+        } else if constexpr (std::is_same_v<O, LcpSequenceOptions>) {
+          switch (o.inner) {
+            case InnerLcpSolver::bbpgd: return "lcp-bbpgd";
+            case InnerLcpSolver::apgd: return "lcp-apgd";
+            case InnerLcpSolver::minimum_map_newton: return "lcp-newton";
+          }
+          return "lcp";
+        } else {
+          switch (o.optimizer) {
+            case BarrierOptimizer::slsqp: return "barrier-slsqp";
+            case BarrierOptimizer::mma: return "barrier-mma";
+            case BarrierOptimizer::cobyla: return "barrier-cobyla";
+          }
+          return "barrier";
+        }
+      },
+      solver);
+}
+
+// The eq. 29 stopping tolerance TOL of a solver that has one (default, barrier); the LCP
+// sequence's own stops at its first separated iterate by default (tol = 0), so it reports none.
+inline std::optional<double> stopping_tolerance(const ContactSolver& solver) {
+  return std::visit(
+      [](const auto& o) -> std::optional<double> {
+        if constexpr (std::is_same_v<std::decay_t<decltype(o)>, LcpSequenceOptions>)
+          return o.tol > 0.0 ? std::optional<double>(o.tol) : std::nullopt;
+        else
+          return o.tol;
+      },
+      solver);
+}
+
+// Sets TOL (eq. 29) on any solver: the LCP sequence then iterates to it as well.
+inline void set_stopping_tolerance(ContactSolver& solver, double tol) {
+  require_positive(tol, "tol");
+  std::visit([tol](auto& o) { o.tol = tol; }, solver);
+}
+
+// One contact step by the chosen solver (by default the defect-correction solver). Bad input
+// throws std::invalid_argument naming the field before anything changes.
+template <Shape S, MobilityOperator M>
+ContactStepResult solve_contact_step(const ContactStepProblem<S>& problem, M& mobility,
+                                     const ContactStepOptions& options = {},
+                                     const ContactSolver& solver = DefectCorrectionOptions{}) {
+  return std::visit(
+      [&](const auto& o) {
+        using O = std::decay_t<decltype(o)>;
+        if constexpr (std::is_same_v<O, DefectCorrectionOptions>)
+          return solve_contact_step_defect_correction(problem, mobility, options, o);
+        else if constexpr (std::is_same_v<O, LcpSequenceOptions>)
+          return solve_contact_step_lcp_sequence(problem, mobility, options, o);
+        else
+          return solve_contact_step_barrier(problem, mobility, options, o);
+      },
+      solver);
+}
+
+}  // namespace stokescontact

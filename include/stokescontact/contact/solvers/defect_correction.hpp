@@ -1,0 +1,246 @@
+#pragma once
+// The default contact solver: the complementarity problem of eq. 27,
+//     0 <= lambda  _|_  d(lambda) - d_hat (1 + margin) >= 0,   d = d^P(Q(lambda)),
+// solved by defect correction with a probed Delassus matrix. Its solution is also the one of
+// the barrier method (eq. 15): no pair below d_hat, and a force only on pairs held at the
+// threshold, so no force larger than needed.
+//
+// Why it is cheap. Of the Nc pairs flagged by d_try, only the few that the trial step brings
+// below d_hat need a force (in the Fig. 4 scenes ~4% of them), and those are spread through the
+// suspension. We keep a working set W of those pairs (and of any pair a correction brings below
+// the threshold) and approximate A = dt D^T M D on W by probing (delassus_probing.hpp):
+// contacts far apart share one mobility application. Each iteration then solves the LCP of the
+// linear model about the current iterate on W, a small dense problem (minimum-map Newton, no
+// mobility applications),
+//     0 <= lambda_W  _|_  d_W(lambda_k) + A~ (lambda_W - lambda_k,W) - d_hat (1 + margin) >= 0,
+// and measures the true distances at the new lambda: one application for M D lambda. The true
+// d(lambda_k) enters every model, so a fixed point solves eq. 27 exactly whatever A~ is; the
+// probing error (far-field coupling, a few per cent) sets the contraction rate per iteration.
+// For spheres the linear model underestimates each centre distance (it is convex in the
+// displacements), which keeps the iterates on the separated side.
+//
+// Refinements, each measured on the Fig. 4 scenes or a hard case in the tests:
+//  - pairs outside W that the model predicts the new lambda brings below the target join W
+//    before the distances are measured (their rows come free with the probes);
+//  - from the second correction on, each measured step (delta lambda, delta d) corrects A~ by
+//    a multisecant update (secant_update.hpp); the memory is dropped when a correction makes
+//    the worst shortfall grow (line contacts of parallel rods, whose closest points jump);
+//  - A~ is lifted to positive definite where probing errors leave it indefinite;
+//  - where probes are shared and two corrections in a row fail to halve the shortfall (large
+//    dense clusters, whose many far fields add up), the round is finished by the LCP sequence
+//    with exact products, polished to complementarity (solver_lcp_sequence.hpp).
+//
+// Stopping rule (eq. 29 form): at an iterate whose flagged pairs all have d >= d_hat, stop when
+// the next correction would change lambda by less than tol ||lambda||_inf; that iterate is
+// returned, so separation is measured, never predicted. The margin puts roundoff and the
+// remaining probing error on the separated side; it costs a relative force excess of about
+// margin d_hat / (the overlap the force removes).
+//
+// Cost: the probes (one per colour of each batch of new working-set pairs) plus one
+// application per iteration; 0 when no pair comes below d_hat. In formed mode every probe is
+// one exact column of M D (cached by the step), A~ = A, and the iterations are free.
+// Iterations reported: corrections (LCPs solved).
+#include <algorithm>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "stokescontact/contact/contact_step.hpp"
+#include "stokescontact/contact/solvers/delassus_probing.hpp"
+#include "stokescontact/lcp/minimum_map_newton.hpp"
+#include "stokescontact/contact/solvers/secant_update.hpp"
+#include "stokescontact/contact/solvers/lcp_sequence.hpp"
+
+namespace stokescontact {
+
+struct DefectCorrectionOptions {
+  double margin = 1e-4;               // target d_hat (1 + margin)
+  double tol = 1e-4;                  // eq. 29 rule on successive corrections
+  double probe_radius_factor = 4.0;   // probe radius = factor x the largest bounding radius
+  int max_iterations = 50;            // corrections per round
+  double contraction = 0.5;           // a correction must shrink the shortfall by this factor ...
+                                      // ... or, twice in a row, the LCP sequence takes over
+  LcpOptions lcp{1e-12};              // each small LCP's stopping rule
+
+  void validate() const {
+    require_non_negative(margin, "DefectCorrectionOptions.margin");
+    require_positive(tol, "DefectCorrectionOptions.tol");
+    require_positive(probe_radius_factor, "DefectCorrectionOptions.probe_radius_factor");
+    if (!(contraction > 0.0 && contraction <= 1.0))
+      fail_argument("DefectCorrectionOptions.contraction", "must lie in (0, 1], got " + std::to_string(contraction));
+    if (max_iterations < 1)
+      fail_argument("DefectCorrectionOptions.max_iterations", "must be >= 1, got " + std::to_string(max_iterations));
+    lcp.validate();
+  }
+};
+
+namespace detail {
+
+template <Shape S>
+double largest_bounding_radius(std::span<const S> shapes) {
+  double r = 0.0;
+  for (const S& s : shapes) r = std::max(r, bounding_radius(s));
+  return r;
+}
+
+// The nearest matrix to the symmetric A~ whose eigenvalues are >= floor x its largest (A~
+// itself when it is positive definite). The true A = dt D^T M D is positive semi-definite, and
+// singular when the contacts outnumber the bodies' degrees of freedom (dense packings);
+// probing errors can then make A~ indefinite, and its LCP unsolvable.
+inline MatX positive_definite(const MatX& A, double floor = 1e-3) {
+  if (A.size() == 0 || Eigen::LLT<MatX>(A).info() == Eigen::Success) return A;
+  const Eigen::SelfAdjointEigenSolver<MatX> eigen(A);
+  const VecX& values = eigen.eigenvalues();
+  const double smallest = floor * values.maxCoeff();
+  return eigen.eigenvectors() * values.cwiseMax(smallest).asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+// The working set's LCP of the linear model about the current iterate (A: the model's matrix
+// on W, distances: all flagged pairs at the iterate); the new lambda on all pairs, none if the
+// LCP solver did not converge.
+inline std::optional<VecX> solve_working_set_lcp(const MatX& A, std::span<const Eigen::Index> W, const VecX& lambda,
+                                  const VecX& distances, double target, const LcpOptions& options) {
+  const auto n = static_cast<Eigen::Index>(W.size());
+  VecX lambda_W(n), d_W(n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    lambda_W(r) = lambda(W[static_cast<std::size_t>(r)]);
+    d_W(r) = distances(W[static_cast<std::size_t>(r)]);
+  }
+  const VecX b = d_W - VecX::Constant(n, target) - A * lambda_W;
+  const LcpResult lcp = solve_lcp_minimum_map_newton(A, b, options, &lambda_W);
+  if (!lcp.converged) return std::nullopt;
+  VecX next = VecX::Zero(lambda.size());
+  for (Eigen::Index r = 0; r < n; ++r) next(W[static_cast<std::size_t>(r)]) = lcp.gamma(r);
+  return next;
+}
+
+// The fallback of a round whose corrections do not contract.
+template <Shape S, MobilityOperator M>
+ContactSolveOutcome finish_by_lcp_sequence(ContactStep<S, M>& step, const VecX& lambda, int corrections,
+                                           const DefectCorrectionOptions& options) {
+  LcpSequenceOptions sequence;
+  sequence.tol = options.tol;  // on to complementarity, as the corrections would have
+  sequence.margin = options.margin;
+  ContactSolveOutcome out = solve_lcp_sequence_round(step, lambda, sequence);
+  out.message = "default solver: probing did not contract after " + std::to_string(corrections) +
+                " corrections, finished by the LCP sequence (" + std::to_string(out.iterations) + " LCPs)" +
+                (out.message.empty() ? "" : ": " + out.message);
+  out.iterations += corrections;
+  return out;
+}
+
+// One round from the warm start (the previous round's lambda, zero-padded).
+template <Shape S, MobilityOperator M>
+ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX lambda, const DefectCorrectionOptions& options) {
+  ContactSolveOutcome out;
+  const double d_hat = step.problem().d_hat, target = d_hat * (1.0 + options.margin);
+  const double radius = step.options().cost == MobilityCost::formed
+                            ? std::numeric_limits<double>::infinity()
+                            : options.probe_radius_factor * largest_bounding_radius(step.problem().shapes);
+  DelassusProbing probing(step, radius);
+  SecantCorrection secant;
+  std::vector<char> member(static_cast<std::size_t>(step.nc()), 0);
+  const auto join = [&](std::vector<Eigen::Index>& joining, Eigen::Index k) {
+    if (member[static_cast<std::size_t>(k)]) return;
+    member[static_cast<std::size_t>(k)] = 1;
+    joining.push_back(k);
+  };
+  VecX previous_lambda, previous_distances;
+  MatX probed;  // positive_definite(probing.matrix()), recomputed when the working set grows
+  double previous_shortfall = std::numeric_limits<double>::infinity();
+  double best_shortfall = std::numeric_limits<double>::infinity();
+  VecX best_lambda = lambda;
+  int slow_corrections = 0;
+  for (;;) {
+    const ContactEvaluation& e = step.evaluate(lambda);
+    // The working set: every pair below the target or pushed...
+    std::vector<Eigen::Index> joining;
+    for (Eigen::Index k = 0; k < step.nc(); ++k)
+      if (e.distances(k) < target || lambda(k) > 0.0) join(joining, k);
+    // Secant pairs from the second correction on (the first is far from linear); a correction
+    // that made the worst shortfall grow shows the model is not to be trusted (line contacts
+    // whose closest points jump, e.g. parallel rods): the memory is dropped.
+    const double shortfall = std::max(0.0, target - e.min_distance());
+    if (shortfall > previous_shortfall) {
+      secant.clear();
+    } else if (out.iterations > 1) {
+      secant.add(lambda - previous_lambda, e.distances - previous_distances);
+    }
+    // Probes shared by contacts whose coupling is not small (large dense clusters, where the
+    // far fields of many contacts add up) give a model too poor to contract: after two
+    // corrections that did not halve the shortfall, the round is finished by the LCP sequence
+    // with exact (matrix-free) products, from the best iterate.
+    if (shortfall < best_shortfall) {
+      best_shortfall = shortfall;
+      best_lambda = lambda;
+    }
+    // (With every probe a single contact the model is exact, and slowness is the geometry's.)
+    const bool shared_probes = probing.probes() < static_cast<int>(probing.members().size());
+    slow_corrections = shared_probes && shortfall > options.contraction * previous_shortfall ? slow_corrections + 1 : 0;
+    if (slow_corrections == 2) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options);
+    previous_shortfall = shortfall;
+    VecX next;
+    for (;;) {
+      probing.add(step, joining);
+      const std::vector<Eigen::Index>& W = probing.members();
+      // The secant-corrected model is not symmetric; should its LCP fail, the probed one (made
+      // positive definite) is a strictly convex QP.
+      if (probed.rows() != static_cast<Eigen::Index>(W.size())) probed = positive_definite(probing.matrix());
+      std::optional<VecX> solved =
+          solve_working_set_lcp(secant.corrected(probed, W), W, lambda, e.distances, target, options.lcp);
+      if (!solved) solved = solve_working_set_lcp(probed, W, lambda, e.distances, target, options.lcp);
+      if (!solved) {
+        out.message = "default solver: the working-set LCP (" + std::to_string(W.size()) + " pairs) did not converge";
+        out.lambda = std::move(lambda);
+        return out;
+      }
+      next = std::move(*solved);
+      // ... and every pair the model predicts the new lambda brings below it (free: the probes
+      // already hold those rows).
+      joining.clear();
+      VecX change_W(static_cast<Eigen::Index>(W.size()));
+      for (std::size_t r = 0; r < W.size(); ++r) change_W(static_cast<Eigen::Index>(r)) = next(W[r]) - lambda(W[r]);
+      for (Eigen::Index k = 0; k < step.nc(); ++k)
+        if (!member[static_cast<std::size_t>(k)] && e.distances(k) + probing.row(k).dot(change_W) < target)
+          join(joining, k);
+      if (joining.empty()) break;
+    }
+    const double change = (next - lambda).lpNorm<Eigen::Infinity>();
+    const double scale = std::max(next.lpNorm<Eigen::Infinity>(), lambda.lpNorm<Eigen::Infinity>());
+    if (e.min_distance() >= d_hat && change <= options.tol * scale) {  // eq. 29 at a separated iterate
+      out.converged = true;
+      break;
+    }
+    if (out.iterations == options.max_iterations) {
+      out.message = "default solver: " + std::to_string(out.iterations) + " corrections, min flagged d / d_hat = " +
+                    std::to_string(e.min_distance() / d_hat) + ", last change " + std::to_string(change / scale) +
+                    " of ||lambda||_inf";
+      break;
+    }
+    ++out.iterations;
+    previous_lambda = lambda;
+    previous_distances = e.distances;
+    lambda = std::move(next);
+  }
+  out.lambda = std::move(lambda);
+  return out;
+}
+
+}  // namespace detail
+
+template <Shape S, MobilityOperator M>
+ContactStepResult solve_contact_step_defect_correction(const ContactStepProblem<S>& problem, M& mobility,
+                                             const ContactStepOptions& options = {},
+                                             const DefectCorrectionOptions& solver = {}) {
+  solver.validate();
+  return run_contact_step(problem, mobility, options, [&solver](ContactStep<S, M>& step, const VecX& warm) {
+    return detail::solve_defect_correction_round(step, warm, solver);
+  });
+}
+
+}  // namespace stokescontact

@@ -1,0 +1,119 @@
+#pragma once
+// The contact step as a sequence of LCPs (Lu et al. Alg. 1; Broms & Tornberg eq. 25-27 with d^P).
+//
+// The nonlinear complementarity problem (eq. 27)
+//     0 <= lambda  _|_  d(lambda) - d_hat >= 0,   d(lambda) = d^P(Q(lambda)),
+// is linearised about the current iterate lambda_k, where the distances d_k = d(lambda_k) are
+// exact. With Q(lambda) = Q_t + dt Psi (U + M D lambda), to first order in dt,
+//     d(lambda) ~ d_k + dt D_k^T M D (lambda - lambda_k),
+// D_k being the contact matrix of the flagged pairs at Q(lambda_k) (D_k^T U = rate of change
+// of d). We replace D_k^T by D^T (D at Q*, exact at k = 0, where Q(0) = Q*), which keeps
+//     A = dt D^T M D   symmetric positive semi-definite
+// so the CQP solvers (BBPGD, APGD) apply, and solve for the total lambda
+//     0 <= lambda  _|_  A lambda + b_k >= 0,   b_k = d_k - d_hat - A lambda_k,
+// warm-started at lambda_k (A lambda_k = dt D^T (M D lambda_k) is free: Q(lambda_k) needed
+// M D lambda_k). Then lambda_{k+1} is re-measured at Q(lambda_{k+1}) and the loop repeats until
+// every flagged pair has d >= d_hat (1 - separation_margin). A fixed point solves eq. 27
+// exactly, whatever the Jacobian approximation, since b_k uses the true distances. For spheres
+// without torques one LCP suffices: a centre distance is convex in the displacements, so the
+// linear model never overestimates d.
+//
+// Cost per outer iteration: the LCP's applications of A (one mobility application each in
+// matrix_free mode, free once M D is formed) plus one for M D lambda_{k+1} (matrix_free).
+// Iterations reported: outer LCPs solved.
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "stokescontact/contact/contact_step.hpp"
+#include "stokescontact/lcp/apgd.hpp"
+#include "stokescontact/lcp/bbpgd.hpp"
+#include "stokescontact/lcp/minimum_map_newton.hpp"
+
+namespace stokescontact {
+
+enum class InnerLcpSolver { bbpgd, apgd, minimum_map_newton };
+
+struct LcpSequenceOptions {
+  InnerLcpSolver inner = InnerLcpSolver::minimum_map_newton;
+  LcpOptions lcp{1e-8};  // each LCP's stopping rule (lcp.hpp)
+  int max_iterations = 20;  // LCPs per round
+  // By default the sequence stops at its first separated iterate, which for spheres is the
+  // first LCP, whose linear model underestimates the distances: pushed pairs may end above
+  // d_hat (forces a few per cent too large in dense packings). With tol > 0 it goes on until
+  // an LCP changes lambda by less than tol ||lambda||_inf (eq. 29), aiming at d_hat (1 +
+  // margin) and then requiring d >= d_hat itself.
+  double tol = 0.0;
+  double margin = 0.0;
+
+  void validate() const {
+    lcp.validate();
+    if (max_iterations < 1)
+      fail_argument("LcpSequenceOptions.max_iterations", "must be >= 1, got " + std::to_string(max_iterations));
+    require_non_negative(tol, "LcpSequenceOptions.tol");
+    require_non_negative(margin, "LcpSequenceOptions.margin");
+  }
+};
+
+namespace detail {
+
+template <typename ApplyA>
+LcpResult solve_inner_lcp(InnerLcpSolver solver, ApplyA& A, const VecX& b, const LcpOptions& options,
+                          const VecX& warm_start) {
+  switch (solver) {
+    case InnerLcpSolver::bbpgd: return solve_lcp_bbpgd(A, b, options, &warm_start);
+    case InnerLcpSolver::apgd: return solve_lcp_apgd(A, b, options, &warm_start);
+    case InnerLcpSolver::minimum_map_newton: return solve_lcp_minimum_map_newton(A, b, options, &warm_start);
+  }
+  return {};
+}
+
+// One round of the sequence, from lambda_0 = warm_start.
+template <Shape S, MobilityOperator M>
+ContactSolveOutcome solve_lcp_sequence_round(ContactStep<S, M>& step, VecX lambda, const LcpSequenceOptions& options) {
+  ContactSolveOutcome out;
+  const double d_hat = step.problem().d_hat, target = d_hat * (1.0 + options.margin);
+  const bool polish = options.tol > 0.0;
+  auto A = [&step](const VecX& x) { return step.A_times(x); };
+  double change = std::numeric_limits<double>::infinity();
+  for (;;) {
+    const ContactEvaluation& e = step.evaluate(lambda);
+    const bool separated = polish ? e.min_distance() >= d_hat : step.all_separated(e);
+    if (separated && (!polish || change <= options.tol * lambda.lpNorm<Eigen::Infinity>())) {
+      out.converged = true;
+      break;
+    }
+    if (out.iterations == options.max_iterations) {
+      out.message = "LCP sequence: " + std::to_string(out.iterations) + " LCPs, min flagged d / d_hat = " +
+                    std::to_string(e.min_distance() / d_hat);
+      break;
+    }
+    ++out.iterations;
+    const VecX A_lambda = step.problem().dt * (step.D().transpose() * e.MD_lambda);
+    const VecX b = e.distances - VecX::Constant(step.nc(), target) - A_lambda;
+    LcpResult lcp = solve_inner_lcp(options.inner, A, b, options.lcp, lambda);
+    if (lcp.gamma == lambda) {  // the LCP has nothing left to change: stalled
+      out.message = "LCP sequence stalled after " + std::to_string(out.iterations) + " LCPs, min flagged d / d_hat = " +
+                    std::to_string(e.min_distance() / d_hat);
+      break;
+    }
+    change = (lcp.gamma - lambda).lpNorm<Eigen::Infinity>();
+    lambda = std::move(lcp.gamma);
+  }
+  out.lambda = std::move(lambda);
+  return out;
+}
+
+}  // namespace detail
+
+template <Shape S, MobilityOperator M>
+ContactStepResult solve_contact_step_lcp_sequence(const ContactStepProblem<S>& problem, M& mobility,
+                                                  const ContactStepOptions& options = {},
+                                                  const LcpSequenceOptions& sequence = {}) {
+  sequence.validate();
+  return run_contact_step(problem, mobility, options, [&sequence](ContactStep<S, M>& step, const VecX& warm) {
+    return detail::solve_lcp_sequence_round(step, warm, sequence);
+  });
+}
+
+}  // namespace stokescontact
