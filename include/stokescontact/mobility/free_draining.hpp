@@ -8,6 +8,17 @@
 //
 // dofs_per_body 3 keeps only the translation block: u_i = R_i N_tt R_i^T f_i. That is exact
 // for torque-free bodies and is what a sphere scene uses (no torques ever formed).
+//
+// Brownian terms, both exact (mobility_operator.hpp, SquareRootMobility and
+// ExactDivergenceMobility):
+//  - apply_sqrt: B = blockdiag(R_i L_k) with L_k the Cholesky factor of the shape's N (the
+//    top-left 3x3 block for 3 dofs), factorised once per shape at construction;
+//    B B^T = R N R^T = M. Isotropic shapes skip the rotation (L L^T = N = M); an isotropic
+//    translation-only shape (a sphere, 3 dofs) is the scalar sqrt(N_00).
+//  - divergence: M_i depends on orientation alone, so only the rotation derivative of the
+//    (velocity, torque) coupling block C_i = R C R^T survives; its divergence is the axial
+//    vector d_j = eps_jkl (C_i)_lk, i.e. R (eps_jkl C_lk) (derivation in docs/brownian.md).
+//    Spheres, Yan's rods and any body with a symmetric coupling block have zero divergence.
 #include <cmath>
 #include <cstddef>
 #include <numbers>
@@ -17,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include "stokescontact/core/errors.hpp"
@@ -87,7 +99,11 @@ class FreeDrainingMobility {
                           " shapes given");
     // A shape whose blocks (those the model uses) are all multiples of I looks the same in
     // every orientation: its bodies skip the rotations.
-    for (const Mat6& n : shapes_) isotropic_.push_back(rotation_invariant(n, dofs_ / 3));
+    for (const Mat6& n : shapes_) {
+      isotropic_.push_back(rotation_invariant(n, dofs_ / 3));
+      cholesky_.push_back(cholesky_factor(n, dofs_));
+      divergence_.push_back(dofs_ == 6 ? coupling_axial_vector(n) : Vec3::Zero());
+    }
     for (const bool iso : isotropic_) needs_rotations_ = needs_rotations_ || !iso;
   }
 
@@ -125,6 +141,37 @@ class FreeDrainingMobility {
     return U;
   }
 
+  // B W with B B^T = M (B = blockdiag(R_i L_k), see the top), one application; W stacked per
+  // body like F.
+  VecX apply_sqrt(const VecX& W) {
+    require_configured();
+    require_finite(W, size(), "W");
+    counter_.count();
+    VecX U(size());
+    const auto n = static_cast<Eigen::Index>(shape_of_body_.size());
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (dofs_ == 6)
+        apply_sqrt_body<6>(i, W, U);
+      else
+        apply_sqrt_body<3>(i, W, U);
+    }
+    return U;
+  }
+
+  // div_q M at the current configuration: per body (R_i d_k, 0) for 6 dofs, 0 for 3 (see the
+  // top). No application.
+  VecX divergence() const {
+    require_configured();
+    VecX d = VecX::Zero(size());
+    if (dofs_ == 3) return d;
+    for (std::size_t i = 0; i < shape_of_body_.size(); ++i) {
+      const std::size_t k = shape_of_body_[i];
+      if (isotropic_[k]) continue;  // coupling c I: symmetric, d_k = 0
+      d.segment<3>(6 * static_cast<Eigen::Index>(i)) = rotations_[i] * divergence_[k];
+    }
+    return d;
+  }
+
   // The block-diagonal matrix, formed directly (0 applications).
   MatX dense_matrix() const {
     require_configured();
@@ -158,6 +205,24 @@ class FreeDrainingMobility {
     return sym;
   }
 
+  // Lower Cholesky factor of the top-left dofs x dofs block of N (SPD, checked above).
+  static Mat6 cholesky_factor(const Mat6& n, int dofs) {
+    Mat6 l = Mat6::Zero();
+    if (dofs == 6)
+      l = n.llt().matrixL();
+    else
+      l.topLeftCorner<3, 3>() = n.topLeftCorner<3, 3>().llt().matrixL();
+    return l;
+  }
+
+  // d_j = eps_jkl C_lk for the body-frame coupling C = N_(velocity, torque), the top-right
+  // block: (C_32 - C_23, C_13 - C_31, C_21 - C_12) = 2 a, with (C - C^T) / 2 = [a x]; zero iff
+  // C = C^T. An axial vector, so the world-frame value is R d.
+  static Vec3 coupling_axial_vector(const Mat6& n) {
+    const Mat3 c = n.topRightCorner<3, 3>();
+    return {c(2, 1) - c(1, 2), c(0, 2) - c(2, 0), c(1, 0) - c(0, 1)};
+  }
+
   static bool rotation_invariant(const Mat6& n, int blocks) {
     for (int r = 0; r < blocks; ++r)
       for (int c = 0; c < blocks; ++c) {
@@ -184,6 +249,24 @@ class FreeDrainingMobility {
     for (int b = 0; b < D; b += 3) U.template segment<3>(D * i + b) = R * u.template segment<3>(b);
   }
 
+  // B_i W_i = R L W_i for body i (L W_i for isotropic shapes, sqrt(N_00) W_i for a sphere's 3).
+  template <int D>
+  void apply_sqrt_body(Eigen::Index i, const VecX& W, VecX& U) const {
+    using VecD = Eigen::Matrix<double, D, 1>;
+    const std::size_t k = shape_of_body_[static_cast<std::size_t>(i)];
+    const auto l = cholesky_[k].template topLeftCorner<D, D>().template triangularView<Eigen::Lower>();
+    if (isotropic_[k]) {
+      if constexpr (D == 3)
+        U.template segment<3>(3 * i) = cholesky_[k](0, 0) * W.template segment<3>(3 * i);
+      else
+        U.template segment<D>(D * i).noalias() = l * W.template segment<D>(D * i);
+      return;
+    }
+    const VecD u = l * W.template segment<D>(D * i);
+    const Mat3& R = rotations_[static_cast<std::size_t>(i)];
+    for (int b = 0; b < D; b += 3) U.template segment<3>(D * i + b) = R * u.template segment<3>(b);
+  }
+
   // World-frame 6x6 block of body i: R N R^T blockwise (for the dense matrix).
   Mat6 block(Eigen::Index i) const {
     const std::size_t k = shape_of_body_[static_cast<std::size_t>(i)];
@@ -203,6 +286,8 @@ class FreeDrainingMobility {
   std::vector<std::size_t> shape_of_body_;
   int dofs_ = 6;
   std::vector<bool> isotropic_;
+  std::vector<Mat6> cholesky_;    // per shape: lower Cholesky factor of N's used block
+  std::vector<Vec3> divergence_;  // per shape: body-frame divergence eps_jkl C_lk (6 dofs)
   bool needs_rotations_ = false;
   std::vector<Mat3> rotations_;  // per body, only when some shape is anisotropic
   bool configured_ = false;

@@ -34,6 +34,32 @@ concept DenseMobilityOperator = MobilityOperator<M> && requires(M& m) {
   { m.dense_matrix() } -> std::convertible_to<MatX>;
 };
 
+// Brownian dynamics (Yan et al. eq. 29 with U_known the Brownian velocity, Sec. IV; Delong,
+// Balboa Usabiaga & Donev, J. Chem. Phys. 143, 144107 (2015)) needs two more things from a
+// model: M^(1/2) W and the thermal drift kT div_q M. Every MobilityOperator gets both from
+// mobility/brownian_velocity.hpp (Lanczos) and mobility/thermal_drift.hpp (random finite
+// differences); a model that can do better says so with the refinements below.
+
+// A model with an exact, cheap square root (libMobility's sqrtMdotW): apply_sqrt(W) = B W for
+// a fixed linear B with B B^T = M at the current configuration. B need not be the symmetric
+// root (a Cholesky factor will do): only the covariance B B^T = M matters for a Brownian
+// increment. Counts one application, like apply.
+template <typename M>
+concept SquareRootMobility = MobilityOperator<M> && requires(M& m, const VecX& W) {
+  { m.apply_sqrt(W) } -> std::convertible_to<VecX>;
+};
+
+// A model that knows the divergence of its mobility exactly at the current configuration:
+// divergence()_a = sum_b d M_ab / d q_b, where q_b moves body b's centre (translation entries)
+// or rotates it by the exponential map (rotation entries, world frame), the coordinates in
+// which random finite differences measure it (Delong et al. 2015). Costs no application and no
+// random numbers: a model whose M does not depend on the configuration returns zeros, and so
+// skips the two extra applications a random finite difference would take.
+template <typename M>
+concept ExactDivergenceMobility = MobilityOperator<M> && requires(const M& cm) {
+  { cm.divergence() } -> std::convertible_to<VecX>;
+};
+
 // Counts applications for a model: the cost unit the papers compare.
 class ApplicationCounter {
  public:
