@@ -29,7 +29,6 @@
 #include <vector>
 
 #include "common/cli.hpp"
-#include "common/solvers.hpp"
 #include "common/sphere_experiment.hpp"
 
 namespace sc = stokescontact;
@@ -48,7 +47,7 @@ struct Options {
   std::uint64_t seed = 1;
   std::vector<double> phis;
   std::size_t spheres = 500;
-  std::string solver;
+  sc::ContactSolver solver;
   ex::MobilityModel mobility = ex::MobilityModel::multiblob;
   ex::StepSettings step;
   std::string output;
@@ -70,7 +69,7 @@ Options parse(int argc, char** argv) {
   o.phis = args.numbers("--phi", o.table1 ? std::vector<double>{0.24} : std::vector<double>{0.24, 0.12}, 1e-6);
   o.spheres = static_cast<std::size_t>(args.integer("--spheres", 500, 2));
   // Fig. 4 uses the default solver; Table 1 is about the barrier method's TOL (eq. 29).
-  o.solver = ex::find_solver(args.text("--solver", o.table1 ? "barrier-slsqp" : ex::kDefaultSolverName)).name;
+  o.solver = sc::contact_solver_from_name(args.text("--solver", o.table1 ? "barrier-slsqp" : "default"));
   o.mobility = ex::parse_mobility(args.text("--mobility", "multiblob"));
   o.step.d_try_multiplier = args.number("--d-try-multiplier", 1.0, 1.0);
   // TOL (eq. 29) replaces the solver's own when given (barrier: 1e-2, the paper's).
@@ -97,8 +96,8 @@ std::string step_json(const Options& o, const ex::SphereScene& scene, double phi
   return "{\"record\": \"step\", \"seed\": " + std::to_string(scene.seed) + ", \"config\": " + std::to_string(config) +
          ", \"phi\": " + sc::json_number(phi) + ", \"phi_reached\": " + sc::json_number(scene.packing.phi) +
          ", \"spheres\": " + std::to_string(o.spheres) + ", \"mobility\": \"" + ex::mobility_name(o.mobility) +
-         "\", \"solver\": \"" + o.solver + "\", \"cost\": \"" + cost_name(o) + "\"" + extra + ", " +
-         ex::json_fields(r) + "}";
+         "\", \"solver\": \"" + sc::contact_solver_name(o.solver) + "\", \"cost\": \"" + cost_name(o) + "\"" +
+         extra + ", " + ex::json_fields(r) + "}";
 }
 
 std::string progress(const ex::StepRecord& r, double phi, int config) {
@@ -126,8 +125,8 @@ struct PhiSummary {
 
 void print_fig4_summary(const Options& o, const std::vector<std::pair<double, PhiSummary>>& rows) {
   std::printf("\nFig. 4: %zu spheres, %s mobility, solver %s, cost %s, d_try x %g, TOL %s\n", o.spheres,
-              ex::mobility_name(o.mobility), o.solver.c_str(), cost_name(o), o.step.d_try_multiplier,
-              o.step.tol ? sc::json_number(*o.step.tol).c_str() : "the solver's own");
+              ex::mobility_name(o.mobility), sc::contact_solver_name(o.solver).c_str(), cost_name(o),
+              o.step.d_try_multiplier, o.step.tol ? sc::json_number(*o.step.tol).c_str() : "the solver's own");
   std::printf("%5s %7s | %-29s | %9s | %-13s | %9s | %7s\n", "phi", "configs", "min d/d_hat after (min med max)",
               "d>=d_hat", "apps (med max)", "med wall", "med Nc");
   for (const auto& [phi, s] : rows)
@@ -139,7 +138,6 @@ void print_fig4_summary(const Options& o, const std::vector<std::pair<double, Ph
 
 template <sc::MobilityOperator M>
 void run_fig4(const Options& o, M& mobility) {
-  const ex::SolverEntry& solver = ex::find_solver(o.solver);
   ex::JsonLines sink(o.output);
   std::vector<std::pair<double, PhiSummary>> rows;
   for (const double phi : o.phis) {
@@ -147,7 +145,7 @@ void run_fig4(const Options& o, M& mobility) {
     for (int c = 0; c < o.configs; ++c) {
       const ex::SphereScene scene = ex::make_scene(fig4_scene(o, phi), o.seed + static_cast<std::uint64_t>(c));
       const sc::VecX U = ex::unconstrained_velocities(mobility, scene);
-      const ex::StepRecord r = ex::run_step(solver, scene, mobility, U, o.step);
+      const ex::StepRecord r = ex::run_step(o.solver, scene, mobility, U, o.step);
       sink.line(step_json(o, scene, phi, c, "", r), progress(r, phi, c));
       summary.add(r);
     }
@@ -187,7 +185,8 @@ struct ForceDeviation {
 
 void print_table1(const Options& o, const std::map<std::pair<int, int>, ForceDeviation>& dev, ex::JsonLines& sink) {
   std::printf("\nTable 1: %zu spheres, phi %.2f, %d configs, %s mobility, solver %s; reference d_try x 1, TOL 5e-6\n",
-              o.spheres, o.phis.front(), o.configs, ex::mobility_name(o.mobility), o.solver.c_str());
+              o.spheres, o.phis.front(), o.configs, ex::mobility_name(o.mobility),
+              sc::contact_solver_name(o.solver).c_str());
   std::printf("%-9s %-8s | %11s %11s | %12s | %9s %9s | %s\n", "d_try", "TOL", "msd", "msd/|f|^2", "max rel diff",
               "med apps", "med Nc", "min d/d_hat after");
   for (const auto& [key, d] : dev) {
@@ -214,9 +213,9 @@ void print_table1(const Options& o, const std::map<std::pair<int, int>, ForceDev
 
 template <sc::MobilityOperator M>
 void run_table1(const Options& o, M& mobility) {
-  const ex::SolverEntry& solver = ex::find_solver(o.solver);
-  if (!ex::has_tol(solver))
-    std::fprintf(stderr, "note: %s has no TOL (eq. 29); only d_try varies\n", solver.name.c_str());
+  if (!sc::stopping_tolerance(o.solver))
+    std::fprintf(stderr, "note: %s has no TOL (eq. 29); only d_try varies\n",
+                 sc::contact_solver_name(o.solver).c_str());
   const double phi = o.phis.front();
   ex::JsonLines sink(o.output);
   std::map<std::pair<int, int>, ForceDeviation> deviations;
@@ -229,7 +228,7 @@ void run_table1(const Options& o, M& mobility) {
         ex::StepSettings settings = o.step;
         settings.d_try_multiplier = kMultipliers[static_cast<std::size_t>(m)];
         settings.tol = kTols[static_cast<std::size_t>(t)];
-        const ex::StepRecord r = ex::run_step(solver, scene, mobility, U, settings);
+        const ex::StepRecord r = ex::run_step(o.solver, scene, mobility, U, settings);
         if (!reference) reference = r.sphere_forces;
         deviations[{m, t}].add(r, *reference);
         const std::string extra = ", \"d_try_multiplier\": " + sc::json_number(settings.d_try_multiplier) +

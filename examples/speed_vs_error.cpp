@@ -1,8 +1,8 @@
-// Speed versus error of every registered contact solver on the same sphere scenes: the Fig. 4
-// suspensions (Broms & Tornberg Sec. 3.1.1; 500 unit spheres, phi 0.24 and 0.12, random
-// sequential addition) and a near-jammed packing (phi ~0.55, 200 spheres by default, by
-// compression with overlap relaxation; sphere_packing.hpp). Same step as Fig. 4: d_hat = the
-// minimum gap, |f_i| = 100, dt = 0.01, U = M f not counted.
+// Speed versus error of every contact solver the library names (contact_solver_names) on the
+// same sphere scenes: the Fig. 4 suspensions (Broms & Tornberg Sec. 3.1.1; 500 unit spheres,
+// phi 0.24 and 0.12, random sequential addition) and a near-jammed packing (phi ~0.55, 200
+// spheres by default, by compression with overlap relaxation; sphere_packing.hpp). Same step
+// as Fig. 4: d_hat = the minimum gap, |f_i| = 100, dt = 0.01, U = M f not counted.
 //
 //   speed_vs_error [--configs 20] [--seed 1] [--scenes fig4-0.24,fig4-0.12,jammed-0.55]
 //                  [--spheres 500] [--jammed-spheres 200] [--mobility rpy|multiblob|free-draining]
@@ -29,7 +29,6 @@
 #include <vector>
 
 #include "common/cli.hpp"
-#include "common/solvers.hpp"
 #include "common/sphere_experiment.hpp"
 
 namespace sc = stokescontact;
@@ -49,7 +48,7 @@ struct Options {
   std::vector<ex::SceneSpec> scenes;
   ex::MobilityModel mobility = ex::MobilityModel::rpy;
   std::vector<sc::MobilityCost> costs;
-  std::vector<const ex::SolverEntry*> solvers;
+  std::vector<sc::ContactSolver> solvers;
   ex::StepSettings step;
   std::string output;
 };
@@ -99,12 +98,10 @@ Options parse(int argc, char** argv) {
   // Default: every solver but COBYLA, which is derivative free and needs hours (and fails to
   // separate) at Nc ~ 200-1000: 20-80 s per step, 1000 evaluations, at Nc ~ 200 in our runs.
   const std::vector<std::string> names = args.list("--solvers", {"except-cobyla"});
-  for (const ex::SolverEntry& e : ex::solver_registry())
-    if (names == std::vector<std::string>{"all"} ||
-        (names == std::vector<std::string>{"except-cobyla"} && e.name != "barrier-cobyla"))
-      o.solvers.push_back(&e);
-  if (o.solvers.empty())
-    for (const std::string& n : names) o.solvers.push_back(&ex::find_solver(n));
+  const bool all = names == std::vector<std::string>{"all"};
+  const bool except_cobyla = names == std::vector<std::string>{"except-cobyla"};
+  for (const std::string& n : all || except_cobyla ? sc::contact_solver_names() : names)
+    if (!(except_cobyla && n == "barrier-cobyla")) o.solvers.push_back(sc::contact_solver_from_name(n));
   o.step.tol = args.positive("--tol");
   o.step.options.separation_margin = args.number("--separation-margin", o.step.options.separation_margin, 0.0);
   o.step.options.validate();
@@ -115,7 +112,7 @@ Options parse(int argc, char** argv) {
 
 // One solve of one configuration.
 struct Solve {
-  const ex::SolverEntry* solver;
+  std::size_t solver;  // index into Options::solvers
   sc::MobilityCost cost;
   ex::StepRecord record;
   double shortfall = 0.0;
@@ -160,9 +157,9 @@ void print_summary(const Options& o, const std::map<SummaryKey, Summary>& summar
   for (const auto& [key, s] : summaries) {
     const auto [scene, solver, cost] = key;
     std::printf("%-12s %-15s %-11s | %8.4fs %8.0f | %10.2e | %10.2e %10.2e | %d\n", o.scenes[scene].name.c_str(),
-                o.solvers[solver]->name.c_str(), cost_name(o.costs[static_cast<std::size_t>(cost)]), ex::median(s.wall),
-                ex::median(s.applications), ex::maximum(s.shortfall), ex::median(s.excess), ex::maximum(s.excess),
-                s.not_converged);
+                sc::contact_solver_name(o.solvers[solver]).c_str(), cost_name(o.costs[static_cast<std::size_t>(cost)]),
+                ex::median(s.wall), ex::median(s.applications), ex::maximum(s.shortfall), ex::median(s.excess),
+                ex::maximum(s.excess), s.not_converged);
   }
 }
 
@@ -171,8 +168,9 @@ std::string solve_json(const Options& o, const ex::SceneSpec& spec, const ex::Sp
   return "{\"scene\": \"" + spec.name + "\", \"spheres\": " + std::to_string(spec.spheres) +
          ", \"phi\": " + sc::json_number(spec.phi) + ", \"phi_reached\": " + sc::json_number(scene.packing.phi) +
          ", \"config\": " + std::to_string(config) + ", \"seed\": " + std::to_string(scene.seed) +
-         ", \"mobility\": \"" + ex::mobility_name(o.mobility) + "\", \"solver\": \"" + s.solver->name +
-         "\", \"cost\": \"" + cost_name(s.cost) + "\", \"shortfall\": " + sc::json_number(s.shortfall) +
+         ", \"mobility\": \"" + ex::mobility_name(o.mobility) +
+         "\", \"solver\": \"" + sc::contact_solver_name(o.solvers[s.solver]) + "\", \"cost\": \"" + cost_name(s.cost) +
+         "\", \"shortfall\": " + sc::json_number(s.shortfall) +
          ", \"excess\": " + sc::json_number(s.excess) + ", " + ex::json_fields(s.record) + "}";
 }
 
@@ -180,11 +178,11 @@ template <sc::MobilityOperator M>
 std::vector<Solve> solve_all(const Options& o, const ex::SphereScene& scene, M& mobility) {
   const sc::VecX U = ex::unconstrained_velocities(mobility, scene);
   std::vector<Solve> solves;
-  for (const ex::SolverEntry* solver : o.solvers)
+  for (std::size_t solver = 0; solver < o.solvers.size(); ++solver)
     for (const sc::MobilityCost cost : o.costs) {
       ex::StepSettings settings = o.step;
       settings.options.cost = cost;
-      solves.push_back({solver, cost, ex::run_step(*solver, scene, mobility, U, settings)});
+      solves.push_back({solver, cost, ex::run_step(o.solvers[solver], scene, mobility, U, settings)});
     }
   score(solves);
   return solves;
@@ -200,10 +198,8 @@ void run(const Options& o) {
       const ex::SphereScene scene = ex::make_scene(spec, o.seed + static_cast<std::uint64_t>(c));
       const std::vector<Solve> solves = std::visit([&](auto& m) { return solve_all(o, scene, m); }, mobility);
       for (const Solve& s : solves) {
-        const std::size_t solver = static_cast<std::size_t>(
-            std::find(o.solvers.begin(), o.solvers.end(), s.solver) - o.solvers.begin());
         const int cost = static_cast<int>(std::find(o.costs.begin(), o.costs.end(), s.cost) - o.costs.begin());
-        summaries[{k, solver, cost}].add(s);
+        summaries[{k, s.solver, cost}].add(s);
         sink.line(solve_json(o, spec, scene, c, s));
       }
       if (sink.to_file())

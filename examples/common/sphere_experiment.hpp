@@ -3,21 +3,21 @@
 // sphere drivers share. A scene is a contact-free packing (sphere_packing.hpp) with
 // d_hat = its minimum gap and forces of random direction, |f_i| = 100. The unconstrained
 // velocities U = M f cost one mobility application, not counted in the contact step; the step
-// itself (dt = 0.01, d^P, d_try of eq. 31 times a multiplier) is run by a registered solver
-// and summarised in a StepRecord.
+// itself (dt = 0.01, d^P, d_try of eq. 31 times a multiplier) is run by a contact solver
+// chosen by value (contact_solver_from_name) and summarised in a StepRecord.
 #include <stokescontact/stokescontact.hpp>
 
 #include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <random>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
 
-#include "common/solvers.hpp"
 #include "common/sphere_packing.hpp"
 
 namespace examples {
@@ -124,7 +124,7 @@ sc::VecX unconstrained_velocities(M& mobility, const SphereScene& scene) {
 
 struct StepSettings {
   double d_try_multiplier = 1.0;  // Sec. 3.1.2: 1, 1.1, 1.2
-  std::optional<double> tol;      // eq. 29 TOL; none: the solver's own
+  std::optional<double> tol;      // eq. 29 TOL for solvers that have one; none: the solver's own
   sc::ContactStepOptions options;  // cost mode, separation margin
   bool pair_details = false;       // keep per-pair distances and forces (Fig. 4c, 4e, 5)
 };
@@ -148,27 +148,7 @@ struct StepRecord {
   std::vector<double> pair_trial_over_d_try, pair_after_over_d_hat, pair_lambda_over_f;
 };
 
-inline const char* status_name(sc::ContactStepStatus s) {
-  switch (s) {
-    case sc::ContactStepStatus::converged: return "converged";
-    case sc::ContactStepStatus::not_converged: return "not_converged";
-    case sc::ContactStepStatus::failed_separation: return "failed_separation";
-  }
-  return "?";
-}
-
 namespace detail {
-
-// Q* = Q_t + dt Psi U (eq. 16).
-inline std::vector<sc::Pose> trial_poses(const std::vector<sc::Pose>& poses, const sc::VecX& U, int dofs) {
-  std::vector<sc::Pose> next(poses.size());
-  for (std::size_t b = 0; b < poses.size(); ++b) {
-    const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs;
-    const sc::Vec3 omega = dofs == 6 ? sc::Vec3(U.segment<3>(row + 3)) : sc::Vec3::Zero();
-    next[b] = sc::advance(poses[b], U.segment<3>(row), omega, kTimeStep);
-  }
-  return next;
-}
 
 inline sc::VecX force_part(const sc::VecX& contact_forces, int dofs) {
   const Eigen::Index n = contact_forces.size() / dofs;
@@ -193,12 +173,16 @@ inline void keep_pair_details(const sc::ContactStepResult& r, StepRecord& out) {
 }  // namespace detail
 
 template <sc::MobilityOperator M>
-StepRecord run_step(const SolverEntry& solver, const SphereScene& scene, M& mobility, const sc::VecX& U,
+StepRecord run_step(const sc::ContactSolver& solver, const SphereScene& scene, M& mobility, const sc::VecX& U,
                     const StepSettings& settings) {
   const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
   const sc::ContactStepProblem<sc::Sphere> problem{shapes, scene.packing.poses, U, kTimeStep, scene.d_hat,
                                                    0.0,    settings.d_try_multiplier, {}};
-  const sc::ContactStepResult r = solve(solver, problem, mobility, settings.options, settings.tol);
+  // TOL replaces the solver's own where it has one (default, barrier); the LCP sequence keeps
+  // stopping at its first separated iterate.
+  sc::ContactSolver chosen = solver;
+  if (settings.tol && sc::stopping_tolerance(chosen)) sc::set_stopping_tolerance(chosen, *settings.tol);
+  const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, settings.options, chosen);
   const int dofs = mobility.dofs_per_body();
   StepRecord out;
   out.d_hat = scene.d_hat;
@@ -208,7 +192,7 @@ StepRecord run_step(const SolverEntry& solver, const SphereScene& scene, M& mobi
     if (r.lambda(k) > kActiveFraction * r.lambda_max) ++out.active;
     if (r.pairs[static_cast<std::size_t>(k)].points.distance < scene.d_hat) ++out.violating_trial;
   }
-  const std::vector<sc::Pose> trial = detail::trial_poses(scene.packing.poses, U, dofs);
+  const std::vector<sc::Pose> trial = sc::advance_all(scene.packing.poses, U, dofs, kTimeStep);  // Q*, eq. 16
   out.min_ratio_trial =
       sc::minimum_pair_distance(sc::Sphere{1.0}, std::span<const sc::Pose>(trial)).distance / scene.d_hat;
   out.min_ratio_after = r.min_distance_ratio;
@@ -217,7 +201,7 @@ StepRecord run_step(const SolverEntry& solver, const SphereScene& scene, M& mobi
   out.wall_time_s = r.wall_time_s;
   out.lambda_sum = r.lambda_sum;
   out.lambda_max_over_f = r.lambda_max / kForceMagnitude;
-  out.status = status_name(r.status);
+  out.status = sc::to_string(r.status);
   out.message = r.message;
   out.sphere_forces = detail::force_part(r.contact_forces, dofs);
   if (settings.pair_details) detail::keep_pair_details(r, out);
@@ -226,21 +210,6 @@ StepRecord run_step(const SolverEntry& solver, const SphereScene& scene, M& mobi
 
 // ---------------------------------------------------------------------------------------
 // JSON.
-
-inline std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) out += c;
-  }
-  return out + "\"";
-}
-
-inline std::string json_numbers(const std::vector<double>& v) {
-  std::string out = "[";
-  for (std::size_t k = 0; k < v.size(); ++k) out += (k ? ", " : "") + sc::json_number(v[k]);
-  return out + "]";
-}
 
 // The record's fields as `"key": value, ...` (no braces), for a driver's JSON object.
 inline std::string json_fields(const StepRecord& r) {
@@ -252,12 +221,12 @@ inline std::string json_fields(const StepRecord& r) {
      << ", \"min_d_over_d_hat_after\": " << sc::json_number(r.min_ratio_after) << ", \"iterations\": " << r.iterations
      << ", \"mobility_applications\": " << r.applications << ", \"wall_time_s\": " << sc::json_number(r.wall_time_s)
      << ", \"lambda_sum\": " << sc::json_number(r.lambda_sum)
-     << ", \"lambda_max_over_f\": " << sc::json_number(r.lambda_max_over_f) << ", \"status\": " << json_string(r.status)
-     << ", \"message\": " << json_string(r.message);
+     << ", \"lambda_max_over_f\": " << sc::json_number(r.lambda_max_over_f)
+     << ", \"status\": " << sc::json_quoted(r.status) << ", \"message\": " << sc::json_quoted(r.message);
   if (r.has_pair_details)
-    os << ", \"pair_d_trial_over_d_try\": " << json_numbers(r.pair_trial_over_d_try)
-       << ", \"pair_d_after_over_d_hat\": " << json_numbers(r.pair_after_over_d_hat)
-       << ", \"pair_lambda_over_f\": " << json_numbers(r.pair_lambda_over_f);
+    os << ", \"pair_d_trial_over_d_try\": " << sc::json_array(r.pair_trial_over_d_try)
+       << ", \"pair_d_after_over_d_hat\": " << sc::json_array(r.pair_after_over_d_hat)
+       << ", \"pair_lambda_over_f\": " << sc::json_array(r.pair_lambda_over_f);
   return os.str();
 }
 

@@ -1,10 +1,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstddef>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
+#include "common/test_support.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 
 namespace sc = stokescontact;
@@ -81,4 +85,37 @@ TEST(RigidMotion, AdvanceRejectsBadInput) {
   sc::Pose bad;
   bad.q = sc::Quat(2.0, 0, 0, 0);
   EXPECT_THROW(sc::advance(bad, sc::Vec3::Zero(), sc::Vec3::Zero(), 0.1), std::invalid_argument);
+}
+
+// advance_all is advance body by body: (u) per body for 3 dofs (orientation kept), (u, omega) for 6.
+TEST(RigidMotion, AdvanceAllAdvancesEveryBody) {
+  const std::vector<sc::Pose> poses = {{sc::Vec3(1, 2, 3), sc::Quat(Eigen::AngleAxisd(0.4, sc::Vec3::UnitY()))},
+                                       {sc::Vec3(-1, 0, 5), sc::Quat(Eigen::AngleAxisd(1.2, sc::Vec3::UnitX()))}};
+  const double dt = 0.03;
+  sc::VecX U6(12);
+  U6 << 0.1, 0.2, 0.3, -0.7, 0.5, 1.3, 2.0, -1.0, 0.5, 0.0, 3.0, -0.2;
+  const std::vector<sc::Pose> six = sc::advance_all(poses, U6, 6, dt);
+  sc::VecX U3(6);
+  U3 << 0.1, 0.2, 0.3, 2.0, -1.0, 0.5;
+  const std::vector<sc::Pose> three = sc::advance_all(poses, U3, 3, dt);
+  ASSERT_EQ(six.size(), 2u);
+  ASSERT_EQ(three.size(), 2u);
+  for (std::size_t b = 0; b < 2; ++b) {
+    const auto i = static_cast<Eigen::Index>(b);
+    const sc::Pose p6 = sc::advance(poses[b], U6.segment<3>(6 * i), U6.segment<3>(6 * i + 3), dt);
+    EXPECT_EQ(six[b].x, p6.x);
+    EXPECT_EQ(six[b].q.coeffs(), p6.q.coeffs());
+    const sc::Pose p3 = sc::advance(poses[b], U3.segment<3>(3 * i), sc::Vec3::Zero(), dt);
+    EXPECT_EQ(three[b].x, p3.x);
+    EXPECT_EQ(three[b].q.coeffs(), p3.q.coeffs());
+  }
+}
+
+TEST(RigidMotion, AdvanceAllRejectsBadInput) {
+  using test_support::expect_rejects;
+  const std::vector<sc::Pose> poses(2);
+  expect_rejects([&] { (void)sc::advance_all(poses, sc::VecX::Zero(8), 4, 0.1); }, "dofs_per_body");
+  expect_rejects([&] { (void)sc::advance_all(poses, sc::VecX::Zero(7), 3, 0.1); }, "velocities");
+  expect_rejects([&] { (void)sc::advance_all(poses, sc::VecX::Zero(6), 6, 0.1); }, "velocities");
+  EXPECT_THROW((void)sc::advance_all(poses, sc::VecX::Constant(6, std::nan("")), 3, 0.1), std::invalid_argument);
 }

@@ -9,16 +9,14 @@
 #include <numbers>
 #include <optional>
 #include <random>
-#include <sstream>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "common/test_support.hpp"
-#include "stokescontact/contact/solvers/barrier_nlopt.hpp"
-#include "stokescontact/contact/solvers/defect_correction.hpp"
-#include "stokescontact/contact/solvers/lcp_sequence.hpp"
+#include "stokescontact/contact/solvers/contact_solver.hpp"
 #include "stokescontact/dynamics/background_flow.hpp"
 #include "stokescontact/dynamics/time_stepper.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
@@ -34,21 +32,16 @@ using test_support::uniform;
 using test_support::uniform_vector;
 
 using SphereStepper = sc::TimeStepper<sc::Sphere, sc::FreeDrainingMobility>;
-using SphereSolver = SphereStepper::ContactSolver;
+using CustomSphereSolver = SphereStepper::CustomContactSolver;
 
 // Unit spheres in viscosity 1: translational mobility mu = 1 / (6 pi).
 constexpr double kMu = 1.0 / (6.0 * std::numbers::pi);
 constexpr double kMargin = 1e-3;  // ContactStepOptions::separation_margin
 
-const auto kLcpSequence = [](const auto& problem, auto& mobility) {
-  return sc::solve_contact_step_lcp_sequence(problem, mobility);
-};
-const auto kBarrierSlsqp = [](const auto& problem, auto& mobility) {
-  return sc::solve_contact_step_barrier(problem, mobility);
-};
-const auto kDefault = [](const auto& problem, auto& mobility) {
-  return sc::solve_contact_step_defect_correction(problem, mobility);
-};
+// The library's solvers by value, each with its default options.
+const sc::ContactSolver kLcpSequence = sc::LcpSequenceOptions{};  // "lcp-newton"
+const sc::ContactSolver kBarrierSlsqp = sc::BarrierNloptOptions{};  // "barrier-slsqp"
+const sc::ContactSolver kDefault = sc::DefectCorrectionOptions{};  // "default"
 constexpr double kDefaultMargin = 1e-4;  // DefectCorrectionOptions::margin
 
 sc::FreeDrainingMobility sphere_mobility(std::size_t n, int dofs) {
@@ -143,7 +136,7 @@ TEST(TimeStepper, ForcesAndBackgroundFlowAdd) {
 // d_hat, the contact force balancing f (lambda = f once they rest there).
 TEST(TimeStepper, TwoSpheresDrivenHeadOnSettleAtDHat) {
   const double dt = 0.01, d_hat = 0.01, f = 1.0 / kMu;
-  const std::vector<std::pair<std::string, SphereSolver>> solvers = {
+  const std::vector<std::pair<std::string, sc::ContactSolver>> solvers = {
       {"lcp_sequence", kLcpSequence}, {"barrier_slsqp", kBarrierSlsqp}, {"default", kDefault}};
   for (const auto& [name, solver] : solvers) {
     SCOPED_TRACE(name);
@@ -186,10 +179,12 @@ TEST(TimeStepper, TwoSpheresDrivenHeadOnSettleAtDHat) {
   }
 }
 
+// A custom contact solver: the LCP sequence, counting its mobility applications.
 struct CountingSolver {
   std::size_t* last_contact_applications;
-  sc::ContactStepResult operator()(const sc::ContactStepProblem<sc::Sphere>& p, sc::FreeDrainingMobility& m) const {
-    sc::ContactStepResult r = sc::solve_contact_step_lcp_sequence(p, m);
+  sc::ContactStepResult operator()(const sc::ContactStepProblem<sc::Sphere>& p, sc::FreeDrainingMobility& m,
+                                   const sc::ContactStepOptions& options) const {
+    sc::ContactStepResult r = sc::solve_contact_step(p, m, options, kLcpSequence);
     *last_contact_applications = r.mobility_applications;
     return r;
   }
@@ -274,8 +269,8 @@ TEST(TimeStepper, RodsInBiaxialCompressionNeverOverlap) {
   std::vector<sc::Pose> poses;
   for (int i = 0; i < 3; ++i)
     for (int k = 0; k < 2; ++k) poses.push_back({sc::Vec3(0.0, 1.1 * (i - 1), 3.1 * k - 1.55), sc::Quat::Identity()});
-  const std::vector<std::pair<std::string, RodStepper::ContactSolver>> solvers = {{"barrier_slsqp", kBarrierSlsqp},
-                                                                                {"default", kDefault}};
+  const std::vector<std::pair<std::string, sc::ContactSolver>> solvers = {{"barrier_slsqp", kBarrierSlsqp},
+                                                                        {"default", kDefault}};
   for (const auto& [name, solver] : solvers) {
     SCOPED_TRACE(name);
     sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
@@ -305,16 +300,13 @@ TEST(TimeStepper, FailedSeparationIsSurfacedAndTheStateKept) {
   o.d_try = 0.015;
   sc::VecX F = sc::VecX::Zero(9);
   F(0) = 10.0 / kMu;
-  const SphereSolver no_guarantee = [](const sc::ContactStepProblem<sc::Sphere>& p, sc::FreeDrainingMobility& m) {
-    sc::ContactStepOptions c;
-    c.max_guarantee_rounds = 0;
-    return sc::solve_contact_step_lcp_sequence(p, m, c);
-  };
+  sc::TimeStepperOptions no_guarantee = o;
+  no_guarantee.contact_step.max_guarantee_rounds = 0;
   auto mobility = sphere_mobility(3, 3);
-  SphereStepper stepper({sc::Sphere{1.0}}, start, mobility, no_guarantee, o);
+  SphereStepper stepper({sc::Sphere{1.0}}, start, mobility, kLcpSequence, no_guarantee);
   stepper.set_external_forces(F);
-  std::ostringstream json;
-  stepper.set_diagnostics_output(&json);
+  int observed = 0;
+  stepper.add_step_observer([&observed](const sc::StepDiagnostics&, std::span<const sc::Pose>) { ++observed; });
   try {
     stepper.step();
     ADD_FAILURE() << "no exception";
@@ -324,7 +316,7 @@ TEST(TimeStepper, FailedSeparationIsSurfacedAndTheStateKept) {
   EXPECT_EQ(stepper.time(), 0.0);
   EXPECT_EQ(stepper.steps_taken(), 0);
   EXPECT_TRUE(stepper.diagnostics().empty());
-  EXPECT_TRUE(json.str().empty());
+  EXPECT_EQ(observed, 0);  // observers see committed steps only
   for (std::size_t b = 0; b < 3; ++b) EXPECT_EQ(stepper.poses()[b].x, start[b].x);
   // The same step with the guarantee loop adds the B-C pair and succeeds.
   auto mobility2 = sphere_mobility(3, 3);
@@ -335,43 +327,106 @@ TEST(TimeStepper, FailedSeparationIsSurfacedAndTheStateKept) {
   EXPECT_GE(brute_force_min_distance(guarded.poses()), 0.01 * (1.0 - kMargin));
 }
 
-TEST(TimeStepper, DiagnosticsAreWrittenAsOneJsonObjectPerLine) {
+// Observers run after every committed step, in the order added, with that step's diagnostics
+// and Q_{t+dt} as the stepper holds it (centres wrapped into the box). Two spheres pushed
+// along x against each other and across a periodic box: contacts and wraps both happen.
+TEST(TimeStepper, ObserversSeeEveryStepWithTheCommittedPoses) {
+  const double L = 8.0, d_hat = 0.01;
+  sc::TimeStepperOptions o = options(0.05, d_hat);
+  o.box = sc::PeriodicBox{sc::Vec3::Constant(L)};
   auto mobility = sphere_mobility(2, 3);
   SphereStepper stepper({sc::Sphere{1.0}},
-                        {sc::Pose{sc::Vec3(0, 0, 0), sc::Quat::Identity()},
-                         sc::Pose{sc::Vec3(2.02, 0, 0), sc::Quat::Identity()}},
-                        mobility, kLcpSequence, options(0.01, 0.01));
+                        {sc::Pose{sc::Vec3(4.0, 4.0, 4.0), sc::Quat::Identity()},
+                         sc::Pose{sc::Vec3(6.5, 4.0, 4.0), sc::Quat::Identity()}},
+                        mobility, o);
   sc::VecX F(6);
-  F << 1.0 / kMu, 0, 0, -1.0 / kMu, 0, 0;
+  F << 3.0 / kMu, 0, 0, 1.0 / kMu, 0, 0;  // the first catches up with the second: both go on at speed 2
   stepper.set_external_forces(F);
-  std::ostringstream out;
-  stepper.set_diagnostics_output(&out);
-  stepper.run(3);
-  std::istringstream lines(out.str());
-  std::string line;
-  int k = 0;
-  while (std::getline(lines, line)) {
-    const sc::StepDiagnostics& d = stepper.diagnostics()[static_cast<std::size_t>(k)];
-    ++k;
-    EXPECT_EQ(line.front(), '{');
-    EXPECT_EQ(line.back(), '}');
-    EXPECT_EQ(line, sc::to_json(d));
-    for (const std::string& field :
-         {"\"step\": " + std::to_string(k), "\"time\": " + sc::json_number(d.time),
-          "\"min_distance_ratio\": " + sc::json_number(d.min_distance_ratio), std::string("\"status\": \"converged\""),
-          "\"mobility_applications\": " + std::to_string(d.mobility_applications),
-          "\"flagged_pairs\": " + std::to_string(d.flagged_pairs), "\"lambda_sum\": " + sc::json_number(d.lambda_sum)})
-      EXPECT_NE(line.find(field), std::string::npos) << field << " not in " << line;
+  struct Seen {
+    int observer;
+    long step;
+    double time;
+    std::vector<sc::Pose> poses;
+  };
+  std::vector<Seen> seen;
+  for (const int id : {1, 2})
+    stepper.add_step_observer([&stepper, &seen, id](const sc::StepDiagnostics& d, std::span<const sc::Pose> q) {
+      // Called with the stepper's own state, already committed.
+      EXPECT_EQ(&d, &stepper.diagnostics().back());
+      EXPECT_EQ(d.step, stepper.steps_taken());
+      EXPECT_EQ(d.time, stepper.time());
+      EXPECT_EQ(q.data(), stepper.poses().data());
+      EXPECT_EQ(q.size(), 2u);
+      seen.push_back({id, d.step, d.time, std::vector<sc::Pose>(q.begin(), q.end())});
+    });
+  const int steps = 40;
+  std::vector<std::vector<sc::Pose>> committed;
+  std::size_t active = 0, wrapped = 0;
+  for (int n = 1; n <= steps; ++n) {
+    const sc::Vec3 before = stepper.poses()[1].x;
+    active += stepper.step().active_pairs;
+    committed.push_back(stepper.poses());
+    wrapped += (stepper.poses()[1].x - before).norm() > 0.5 * L ? 1 : 0;
   }
-  EXPECT_EQ(k, 3);
-  EXPECT_GT(stepper.diagnostics()[0].active_pairs, 0u);
-  // Strings are escaped; infinities become null.
-  sc::StepDiagnostics d;
-  d.message = "a \"quoted\"\nline";
-  d.min_distance_ratio = std::numeric_limits<double>::infinity();
-  const std::string json = sc::to_json(d);
-  EXPECT_NE(json.find(R"("message": "a \"quoted\"\u000aline")"), std::string::npos) << json;
-  EXPECT_NE(json.find(R"("min_distance_ratio": null)"), std::string::npos) << json;
+  ASSERT_EQ(seen.size(), 2u * steps);
+  for (int n = 1; n <= steps; ++n)
+    for (int id : {1, 2}) {
+      const Seen& s = seen[static_cast<std::size_t>(2 * (n - 1) + id - 1)];
+      EXPECT_EQ(s.observer, id) << "step " << n;  // in the order added
+      EXPECT_EQ(s.step, n);
+      EXPECT_DOUBLE_EQ(s.time, n * o.dt);
+      for (std::size_t b = 0; b < 2; ++b) {
+        const sc::Pose& p = committed[static_cast<std::size_t>(n - 1)][b];
+        EXPECT_EQ(s.poses[b].x, p.x) << "step " << n << " body " << b;
+        EXPECT_EQ(s.poses[b].q.coeffs(), p.q.coeffs()) << "step " << n << " body " << b;
+        EXPECT_TRUE((p.x.array() >= 0.0).all() && (p.x.array() < L).all()) << "step " << n << " body " << b;
+      }
+    }
+  EXPECT_GT(active, 0u);   // the spheres did touch
+  EXPECT_GT(wrapped, 0u);  // and crossed the box
+  EXPECT_GE(brute_force_min_distance(stepper.poses(), L), d_hat * (1.0 - kMargin));
+  // Cleared observers see nothing more.
+  stepper.clear_step_observers();
+  stepper.step();
+  EXPECT_EQ(seen.size(), 2u * steps);
+}
+
+// The three ways to give a solver run the same step: no solver (the default), the default by
+// value, and a custom callable around it, which gets TimeStepperOptions::contact_step.
+TEST(TimeStepper, TheSolverIsTheDefaultUnlessGiven) {
+  const std::vector<sc::Pose> start = {{sc::Vec3(0, 0, 0), sc::Quat::Identity()},
+                                       {sc::Vec3(2.1, 0.3, 0), sc::Quat::Identity()},
+                                       {sc::Vec3(4.2, 0, 0.2), sc::Quat::Identity()}};
+  sc::VecX F = sc::VecX::Zero(9);
+  F(0) = 20.0 / kMu;
+  F(6) = -20.0 / kMu;
+  sc::TimeStepperOptions o = options(0.01, 0.01);
+  o.contact_step.cost = sc::MobilityCost::matrix_free;
+  auto m1 = sphere_mobility(3, 3), m2 = sphere_mobility(3, 3), m3 = sphere_mobility(3, 3);
+  SphereStepper implicit({sc::Sphere{1.0}}, start, m1, o);
+  SphereStepper by_value({sc::Sphere{1.0}}, start, m2, sc::contact_solver_from_name("default"), o);
+  int calls = 0;
+  const CustomSphereSolver around_default = [&calls](const sc::ContactStepProblem<sc::Sphere>& p,
+                                                     sc::FreeDrainingMobility& m, const sc::ContactStepOptions& c) {
+    ++calls;
+    EXPECT_EQ(c.cost, sc::MobilityCost::matrix_free);
+    return sc::solve_contact_step_defect_correction(p, m, c);
+  };
+  SphereStepper custom({sc::Sphere{1.0}}, start, m3, around_default, o);
+  std::size_t active = 0;
+  for (SphereStepper* s : {&implicit, &by_value, &custom}) {
+    s->set_external_forces(F);
+    s->run(10);
+  }
+  for (const sc::StepDiagnostics& d : implicit.diagnostics()) active += d.active_pairs;
+  EXPECT_GT(active, 0u);
+  EXPECT_EQ(calls, 10);
+  for (std::size_t b = 0; b < 3; ++b) {
+    EXPECT_EQ(by_value.poses()[b].x, implicit.poses()[b].x) << "body " << b;
+    EXPECT_EQ(custom.poses()[b].x, implicit.poses()[b].x) << "body " << b;
+  }
+  EXPECT_EQ(m1.applications(), m2.applications());
+  EXPECT_EQ(m1.applications(), m3.applications());
 }
 
 TEST(TimeStepper, RejectsBadInputBeforeChangingAnything) {
@@ -404,7 +459,15 @@ TEST(TimeStepper, RejectsBadInputBeforeChangingAnything) {
     expect_rejects([&] { make(o); }, "background_flow");
   }
   const sc::TimeStepperOptions good = options(0.01, 0.01);
-  expect_rejects([&] { SphereStepper s(shape, two, mobility, SphereSolver{}, good); }, "contact_solver");
+  expect_rejects([&] { SphereStepper s(shape, two, mobility, CustomSphereSolver{}, good); }, "contact_solver");
+  {
+    sc::DefectCorrectionOptions bad_solver;
+    bad_solver.tol = 0.0;
+    expect_rejects([&] { SphereStepper s(shape, two, mobility, bad_solver, good); }, "DefectCorrectionOptions.tol");
+    sc::TimeStepperOptions o = good;
+    o.contact_step.separation_margin = 1.0;
+    expect_rejects([&] { SphereStepper s(shape, two, mobility, o); }, "ContactStepOptions.separation_margin");
+  }
   expect_rejects([&] { SphereStepper s(shape, two, mobility, kLcpSequence, good, nan); }, "t0");
   {
     auto wrong = sphere_mobility(3, 3);
@@ -430,6 +493,7 @@ TEST(TimeStepper, RejectsBadInputBeforeChangingAnything) {
   expect_rejects([&] { stepper.set_external_forces(sc::VecX::Ones(5)); }, "external_forces");
   expect_rejects([&] { stepper.set_external_force_field(sc::ExternalForceField{}); }, "external_forces");
   expect_rejects([&] { stepper.run(-1); }, "steps");
+  expect_rejects([&] { stepper.add_step_observer(sc::StepObserver{}); }, "step_observer");
   stepper.step();
   twin.step();
   for (std::size_t b = 0; b < 2; ++b) EXPECT_EQ(stepper.poses()[b].x, twin.poses()[b].x);

@@ -32,6 +32,7 @@
 #include <span>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -96,6 +97,16 @@ struct ContactStepOptions {
 };
 
 enum class ContactStepStatus { converged, not_converged, failed_separation };
+
+// The status as the drivers' and the stepper's JSON write it: "converged", ...
+constexpr std::string_view to_string(ContactStepStatus status) {
+  switch (status) {
+    case ContactStepStatus::converged: return "converged";
+    case ContactStepStatus::not_converged: return "not_converged";
+    case ContactStepStatus::failed_separation: return "failed_separation";
+  }
+  return "unknown";
+}
 
 // The same result for every solver.
 struct ContactStepResult {
@@ -177,7 +188,7 @@ class ContactStep {
       for (const S& shape : problem.shapes)
         nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : 0.5 * shape.radius));
     }
-    trial_ = advance_all(problem.U);  // eq. 16
+    trial_ = advance_all(problem.poses, problem.U, dofs_, problem.dt);  // Q*, eq. 16
     pairs_ = find_contact_pairs(problem.shapes, std::span<const Pose>(trial_), d_try_, problem.box);
     rebuild();
     // Everything checked: only now touch the mobility.
@@ -227,7 +238,7 @@ class ContactStep {
     ContactEvaluation e;
     e.lambda = lambda;
     e.MD_lambda = MD_times(lambda);
-    e.poses = advance_all(problem_.U + e.MD_lambda);
+    e.poses = advance_all(problem_.poses, problem_.U + e.MD_lambda, dofs_, problem_.dt);  // eq. 13
     e.pairs.reserve(pairs_.size());
     e.distances.resize(nc());
     for (std::size_t k = 0; k < pairs_.size(); ++k) {
@@ -260,16 +271,6 @@ class ContactStep {
   std::size_t applications() const { return mobility_.applications() - start_applications_; }
 
  private:
-  std::vector<Pose> advance_all(const VecX& velocities) const {
-    std::vector<Pose> next(problem_.poses.size());
-    for (std::size_t b = 0; b < next.size(); ++b) {
-      const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs_;
-      const Vec3 omega = dofs_ == 6 ? Vec3(velocities.segment<3>(row + 3)) : Vec3::Zero();
-      next[b] = advance(problem_.poses[b], velocities.segment<3>(row), omega, problem_.dt);
-    }
-    return next;
-  }
-
   // Pairs are only ever appended: columns of M D already formed stay valid.
   void rebuild() {
     last_.reset();

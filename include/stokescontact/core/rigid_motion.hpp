@@ -1,7 +1,12 @@
 #pragma once
 // The map Psi from body velocities (u, omega) to coordinate rates (Broms eq. 4) and the
-// forward-Euler step x' = x + dt u, q' = exp(dt omega / 2) q that keeps q unit length.
+// forward-Euler step x' = x + dt u, q' = exp(dt omega / 2) q that keeps q unit length, for
+// one body (advance) and for every body of a configuration (advance_all).
 #include <cmath>
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
 
 #include "stokescontact/core/pose.hpp"
 
@@ -46,6 +51,25 @@ inline Pose advance(const Pose& pose, const Vec3& u, const Vec3& omega, double d
   next.x = pose.x + dt * u;
   next.q = quaternion_exp(0.5 * dt * omega) * pose.q;
   next.q.normalize();
+  return next;
+}
+
+// Q' = Q + dt Psi U for every body (Broms eq. 16 with U, eq. 13 with U + M D lambda).
+// `velocities` stacks (u) or (u, omega) per body, dofs_per_body 3 or 6 (3: orientations kept).
+inline std::vector<Pose> advance_all(std::span<const Pose> poses, const VecX& velocities, int dofs_per_body,
+                                     double dt) {
+  if (dofs_per_body != 3 && dofs_per_body != 6)
+    fail_argument("dofs_per_body", "must be 3 or 6, got " + std::to_string(dofs_per_body));
+  if (velocities.size() != static_cast<Eigen::Index>(poses.size()) * dofs_per_body)
+    fail_argument("velocities", "size must be dofs_per_body * N = " +
+                                    std::to_string(poses.size() * static_cast<std::size_t>(dofs_per_body)) +
+                                    ", got " + std::to_string(velocities.size()));
+  std::vector<Pose> next(poses.size());
+  for (std::size_t b = 0; b < next.size(); ++b) {
+    const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs_per_body;
+    const Vec3 omega = dofs_per_body == 6 ? Vec3(velocities.segment<3>(row + 3)) : Vec3::Zero();
+    next[b] = advance(poses[b], velocities.segment<3>(row), omega, dt);
+  }
   return next;
 }
 

@@ -2,10 +2,13 @@
 // Forward Euler with contact correction (Broms & Tornberg Sec. 2, 3.2.3). One step from Q_t:
 //   1. U = U_bg(Q_t) + M(Q_t) F_ext(t, Q_t)             (eq. 3, no Brownian term): one mobility
 //      application, skipped when F_ext = 0;
-//   2. a contact step by the user's solver from Q_t with U: the trial step Q* = Q_t + dt Psi U
+//   2. a contact step from Q_t with U by the chosen solver (a ContactSolver value, the default
+//      solver unless told otherwise; or a custom callable): the trial step Q* = Q_t + dt Psi U
 //      (eq. 16), then lambda >= 0 and Q_{t+dt} = Q_t + dt Psi (U + M D lambda)  (eq. 13);
 //   3. Q_{t+dt} = the solver's poses, centres wrapped back into [0, L)^3 in a periodic box
-//      (positions only: the contact code measures pairs by minimum image).
+//      (positions only: the contact code measures pairs by minimum image);
+//   4. the step's StepDiagnostics and Q_{t+dt} go to every step observer (JSON lines through
+//      io/diagnostics_json.hpp, trajectories, statistics: whatever the caller attaches).
 // A background flow with a periodic box is refused: u = E x is not periodic, and
 // Lees-Edwards boundary conditions are not implemented.
 //
@@ -13,20 +16,20 @@
 // std::runtime_error with the solver's message, and the state stays at Q_t. Bad input throws
 // std::invalid_argument naming the field before anything changes.
 #include <chrono>
-#include <cstdio>
 #include <cstddef>
 #include <functional>
 #include <optional>
-#include <ostream>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "stokescontact/contact/contact_step.hpp"
+#include "stokescontact/contact/solvers/contact_solver.hpp"
 #include "stokescontact/dynamics/background_flow.hpp"
-#include "stokescontact/io/json.hpp"
+#include "stokescontact/dynamics/step_diagnostics.hpp"
 
 namespace stokescontact {
 
@@ -37,6 +40,7 @@ struct TimeStepperOptions {
   double d_try_multiplier = 1.0;     // >= 1
   std::optional<PeriodicBox> box;    // none for open space
   std::optional<LinearBackgroundFlow> background_flow;  // none: fluid at rest
+  ContactStepOptions contact_step;   // given to the contact solver at every step
 
   void validate() const {
     require_positive(dt, "dt");
@@ -54,102 +58,46 @@ struct TimeStepperOptions {
         fail_argument("background_flow",
                       "is not allowed with a periodic box (u = E x is not periodic; no Lees-Edwards conditions)");
     }
+    contact_step.validate();
   }
 };
-
-// What one step did: the numbers the papers report per step.
-struct StepDiagnostics {
-  long step = 0;                       // 1 for the first step
-  double time = 0.0;                   // t + dt, the time reached
-  std::size_t flagged_pairs = 0;       // Nc at the trial step (and pairs the guarantee loop added)
-  std::size_t active_pairs = 0;        // pairs with lambda > 0
-  double min_distance_ratio = 0.0;     // min d^P over all pairs of Q_{t+dt} / d_hat (inf: < 2 bodies)
-  ContactStepStatus status = ContactStepStatus::converged;
-  std::string message;                 // the solver's message (empty when it has nothing to say)
-  int iterations = 0;                  // the contact solver's iterations
-  std::size_t unconstrained_applications = 0;  // 1 for M F_ext, 0 when F_ext = 0
-  std::size_t mobility_applications = 0;       // all of the step: the one for U plus the contact step's
-  double wall_time_s = 0.0;            // the whole step
-  double lambda_sum = 0.0;
-  double lambda_max = 0.0;
-};
-
-namespace detail {
-
-inline const char* contact_status_name(ContactStepStatus s) {
-  switch (s) {
-    case ContactStepStatus::converged: return "converged";
-    case ContactStepStatus::not_converged: return "not_converged";
-    case ContactStepStatus::failed_separation: return "failed_separation";
-  }
-  return "unknown";
-}
-
-// A JSON string literal: quotes, backslashes and control characters escaped.
-inline std::string json_quoted(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
-}  // namespace detail
-
-// One line of JSON (no newline); min_distance_ratio is null when infinite (fewer than 2 bodies).
-inline std::string to_json(const StepDiagnostics& d) {
-  return "{\"step\": " + std::to_string(d.step) + ", \"time\": " + json_number(d.time) +
-         ", \"flagged_pairs\": " + std::to_string(d.flagged_pairs) +
-         ", \"active_pairs\": " + std::to_string(d.active_pairs) +
-         ", \"min_distance_ratio\": " + json_number(d.min_distance_ratio) + ", \"status\": " +
-         detail::json_quoted(detail::contact_status_name(d.status)) + ", \"message\": " + detail::json_quoted(d.message) +
-         ", \"iterations\": " + std::to_string(d.iterations) +
-         ", \"unconstrained_applications\": " + std::to_string(d.unconstrained_applications) +
-         ", \"mobility_applications\": " + std::to_string(d.mobility_applications) +
-         ", \"wall_time_s\": " + json_number(d.wall_time_s) + ", \"lambda_sum\": " + json_number(d.lambda_sum) +
-         ", \"lambda_max\": " + json_number(d.lambda_max) + "}";
-}
 
 // External forces (and torques) per body, stacked as the mobility's rows, at time t and poses Q_t.
 using ExternalForceField = std::function<VecX(double, std::span<const Pose>)>;
 
+// Called after every committed step with its diagnostics and Q_{t+dt} (centres wrapped into
+// the box); the span is valid during the call only.
+using StepObserver = std::function<void(const StepDiagnostics&, std::span<const Pose>)>;
+
 template <Shape S, MobilityOperator M>
 class TimeStepper {
  public:
-  // Any of the library's solvers fits through a lambda, e.g.
-  //   [](const ContactStepProblem<S>& p, M& m) { return solve_contact_step_lcp_sequence(p, m); }
-  using ContactSolver = std::function<ContactStepResult(const ContactStepProblem<S>&, M&)>;
+  // Anything else that solves a contact step: it gets each step's problem, the mobility and
+  // options.contact_step, e.g. to count or log around one of the library's solvers.
+  using CustomContactSolver =
+      std::function<ContactStepResult(const ContactStepProblem<S>&, M&, const ContactStepOptions&)>;
 
   // `shapes`: one per body or one shared; `mobility` is referenced and must outlive the
   // stepper. Q_0 must be contact free (every d^P >= 0). Centres are wrapped into the box.
+  // The contact solver: the default one (defect correction with its default options) ...
+  TimeStepper(std::vector<S> shapes, std::vector<Pose> poses, M& mobility, TimeStepperOptions options,
+              double t0 = 0.0)
+      : TimeStepper(std::move(shapes), std::move(poses), mobility, ContactSolver{}, std::move(options), t0) {}
+
+  // ... one of the library's by value, e.g. contact_solver_from_name("lcp-newton") ...
   TimeStepper(std::vector<S> shapes, std::vector<Pose> poses, M& mobility, ContactSolver contact_solver,
               TimeStepperOptions options, double t0 = 0.0)
-      : shapes_(std::move(shapes)), poses_(std::move(poses)), mobility_(mobility),
-        solver_(std::move(contact_solver)), options_(std::move(options)), time_(t0), start_time_(t0) {
-    options_.validate();
-    require_finite(t0, "t0");
-    if (!solver_) fail_argument("contact_solver", "must be given");
-    validate_scene(std::span<const S>(shapes_), std::span<const Pose>(poses_));
-    dofs_ = mobility_.dofs_per_body();
-    if (dofs_ != 3 && dofs_ != 6) fail_argument("mobility", "dofs_per_body must be 3 or 6, got " + std::to_string(dofs_));
-    if (mobility_.size() != size())
-      fail_argument("mobility", "has size " + std::to_string(mobility_.size()) + ", expected " +
-                                    std::to_string(size()) + " (bodies * dofs_per_body)");
-    const MinimumDistance start =
-        minimum_pair_distance(std::span<const S>(shapes_), std::span<const Pose>(poses_), options_.box);
-    if (start.distance < 0.0)
-      fail_argument("poses", "Q_0 must be contact free; bodies " + std::to_string(start.i) + " and " +
-                                 std::to_string(start.j) + " overlap, d = " + std::to_string(start.distance));
-    wrap_into_box();
+      : shapes_(std::move(shapes)), poses_(std::move(poses)), mobility_(mobility), solver_(std::move(contact_solver)),
+        options_(std::move(options)), time_(t0), start_time_(t0) {
+    validate_and_wrap();
+  }
+
+  // ... or a custom callable.
+  TimeStepper(std::vector<S> shapes, std::vector<Pose> poses, M& mobility, CustomContactSolver contact_solver,
+              TimeStepperOptions options, double t0 = 0.0)
+      : shapes_(std::move(shapes)), poses_(std::move(poses)), mobility_(mobility), solver_(std::move(contact_solver)),
+        options_(std::move(options)), time_(t0), start_time_(t0) {
+    validate_and_wrap();
   }
 
   // Constant external forces: size bodies * dofs_per_body, finite. Zero by default.
@@ -166,8 +114,14 @@ class TimeStepper {
     forces_.reset();
   }
 
-  // One JSON object per step is written here (nullptr: none); the stream must outlive its use.
-  void set_diagnostics_output(std::ostream* out) { json_out_ = out; }
+  // Observers run after every committed step, in the order added; not after a step that
+  // throws. One that throws stops run() with the step already committed.
+  void add_step_observer(StepObserver observer) {
+    if (!observer) fail_argument("step_observer", "must be callable");
+    observers_.push_back(std::move(observer));
+  }
+
+  void clear_step_observers() { observers_.clear(); }
 
   // One step; returns its diagnostics (also kept in diagnostics()). Throws std::runtime_error
   // on failed separation.
@@ -190,10 +144,10 @@ class TimeStepper {
       U += mobility_.apply(*forces);
       applications = 1;
     }
-    // Eq. 13/16 through the user's solver.
+    // Eq. 13/16 through the chosen solver.
     const ContactStepProblem<S> problem{std::span<const S>(shapes_), q_t, U, options_.dt, options_.d_hat,
                                         options_.d_try,              options_.d_try_multiplier, options_.box};
-    ContactStepResult result = solver_(problem, mobility_);
+    ContactStepResult result = solve(problem);
     if (result.status == ContactStepStatus::failed_separation)
       throw std::runtime_error("time step " + std::to_string(steps_ + 1) + " from t = " + std::to_string(time_) +
                                ": " + result.message);
@@ -220,7 +174,7 @@ class TimeStepper {
     d.lambda_max = result.lambda_max;
     d.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     diagnostics_.push_back(std::move(d));
-    if (json_out_ != nullptr) *json_out_ << to_json(diagnostics_.back()) << '\n';
+    for (const StepObserver& observer : observers_) observer(diagnostics_.back(), std::span<const Pose>(poses_));
     return diagnostics_.back();
   }
 
@@ -239,6 +193,34 @@ class TimeStepper {
   Eigen::Index size() const { return static_cast<Eigen::Index>(poses_.size()) * dofs_; }
 
  private:
+  // The constructors' checks, before anything else: options, t0, solver, scene, mobility.
+  void validate_and_wrap() {
+    options_.validate();
+    require_finite(time_, "t0");
+    if (const ContactSolver* solver = std::get_if<ContactSolver>(&solver_))
+      std::visit([](const auto& o) { o.validate(); }, *solver);
+    else if (!std::get<CustomContactSolver>(solver_))
+      fail_argument("contact_solver", "must be callable");
+    validate_scene(std::span<const S>(shapes_), std::span<const Pose>(poses_));
+    dofs_ = mobility_.dofs_per_body();
+    if (dofs_ != 3 && dofs_ != 6) fail_argument("mobility", "dofs_per_body must be 3 or 6, got " + std::to_string(dofs_));
+    if (mobility_.size() != size())
+      fail_argument("mobility", "has size " + std::to_string(mobility_.size()) + ", expected " +
+                                    std::to_string(size()) + " (bodies * dofs_per_body)");
+    const MinimumDistance closest =
+        minimum_pair_distance(std::span<const S>(shapes_), std::span<const Pose>(poses_), options_.box);
+    if (closest.distance < 0.0)
+      fail_argument("poses", "Q_0 must be contact free; bodies " + std::to_string(closest.i) + " and " +
+                                 std::to_string(closest.j) + " overlap, d = " + std::to_string(closest.distance));
+    wrap_into_box();
+  }
+
+  ContactStepResult solve(const ContactStepProblem<S>& problem) {
+    if (const CustomContactSolver* custom = std::get_if<CustomContactSolver>(&solver_))
+      return (*custom)(problem, mobility_, options_.contact_step);
+    return solve_contact_step(problem, mobility_, options_.contact_step, std::get<ContactSolver>(solver_));
+  }
+
   // t_n = t_0 + n dt, not a running sum: no drift over many steps.
   double t0_plus_steps() const { return start_time_ + static_cast<double>(steps_) * options_.dt; }
 
@@ -250,7 +232,7 @@ class TimeStepper {
   std::vector<S> shapes_;
   std::vector<Pose> poses_;
   M& mobility_;
-  ContactSolver solver_;
+  std::variant<ContactSolver, CustomContactSolver> solver_;
   TimeStepperOptions options_;
   double time_ = 0.0;
   double start_time_ = 0.0;
@@ -258,7 +240,7 @@ class TimeStepper {
   long steps_ = 0;
   std::optional<VecX> forces_;
   ExternalForceField force_field_;
-  std::ostream* json_out_ = nullptr;
+  std::vector<StepObserver> observers_;
   std::vector<StepDiagnostics> diagnostics_;
 };
 
