@@ -4,7 +4,9 @@
 
 // core
 #include "stokescontact/core/errors.hpp"
+#include "stokescontact/core/gaussian_stream.hpp"
 #include "stokescontact/core/gmres.hpp"
+#include "stokescontact/core/lanczos.hpp"
 #include "stokescontact/core/pose.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 #include "stokescontact/core/types.hpp"
@@ -20,6 +22,7 @@
 #include "stokescontact/geometry/primitives.hpp"
 #include "stokescontact/geometry/segment_distance.hpp"
 #include "stokescontact/geometry/shapes.hpp"
+#include "stokescontact/geometry/surface_distances.hpp"
 #include "stokescontact/geometry/surface_nodes.hpp"
 
 // mobility
@@ -27,6 +30,7 @@
 #include "stokescontact/mobility/blob_models.hpp"
 #include "stokescontact/mobility/blob_rpy.hpp"
 #include "stokescontact/mobility/boomerang_blobs.hpp"
+#include "stokescontact/mobility/brownian_velocity.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/mobility_operator.hpp"
 #include "stokescontact/mobility/multiblob_mobility.hpp"
@@ -39,6 +43,7 @@
 #include "stokescontact/mobility/rpy_rotation_kernel.hpp"
 #include "stokescontact/mobility/single_body_mobility.hpp"
 #include "stokescontact/mobility/sphere_shell.hpp"
+#include "stokescontact/mobility/thermal_drift.hpp"
 
 // lcp (needs only core)
 #include "stokescontact/lcp/apgd.hpp"
@@ -67,7 +72,9 @@
 
 // dynamics
 #include "stokescontact/dynamics/background_flow.hpp"
+#include "stokescontact/dynamics/step_diagnostics.hpp"
 #include "stokescontact/dynamics/time_stepper.hpp"
 
 // io
+#include "stokescontact/io/diagnostics_json.hpp"
 #include "stokescontact/io/json.hpp"
