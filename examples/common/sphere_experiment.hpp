@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "common/solvers.hpp"
-#include "common/sphere_packing.hpp"
+#include "stokescontact/scenes/sphere_packing.hpp"
 
 namespace examples {
 
@@ -86,7 +86,7 @@ struct SceneSpec {
 
 struct SphereScene {
   std::uint64_t seed = 0;
-  SpherePacking packing;
+  sc::SpherePacking packing;
   std::vector<sc::Vec3> forces;
   double d_hat = 0.0;  // the minimum gap (Sec. 3.1.1)
 };
@@ -98,9 +98,9 @@ inline SphereScene make_scene(const SceneSpec& spec, std::uint64_t seed) {
   std::mt19937_64 rng(sequence);
   SphereScene s;
   s.seed = seed;
-  s.packing = spec.packing == PackingKind::dense ? dense_packing(spec.spheres, spec.phi, rng())
-                                                 : random_sequential_addition(spec.spheres, spec.phi, rng());
-  s.forces = random_forces(spec.spheres, kForceMagnitude, rng);
+  s.packing = spec.packing == PackingKind::dense ? sc::dense_packing(spec.spheres, spec.phi, rng())
+                                                 : sc::random_sequential_addition(spec.spheres, spec.phi, rng());
+  s.forces = sc::random_forces(spec.spheres, kForceMagnitude, rng);
   s.d_hat = s.packing.min_gap;
   return s;
 }
