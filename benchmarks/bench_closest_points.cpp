@@ -5,10 +5,10 @@
 #include <benchmark/benchmark.h>
 
 #include <cstddef>
-#include <random>
 #include <vector>
 
 #include "stokescontact/geometry/closest_points.hpp"
+#include "stokescontact/scenes/random.hpp"
 
 namespace {
 
@@ -18,27 +18,16 @@ struct PosePair {
   Pose a, b;
 };
 
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-
-Vec3 random_in_ball(std::mt19937_64& rng, double radius) {
+// Uniform in the ball of this radius (rejection from the cube around it).
+Vec3 random_in_ball(Rng& rng, double radius) {
   for (;;) {
-    const Vec3 v(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Vec3 v = uniform_vector(rng, -1, 1);
     if (v.squaredNorm() <= 1.0) return radius * v;
   }
 }
 
-Quat random_rotation(std::mt19937_64& rng) {
-  for (;;) {
-    const Eigen::Vector4d v(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
-                            uniform(rng, -1, 1));
-    if (v.norm() > 0.1 && v.norm() < 1.0) return Quat(v[0], v[1], v[2], v[3]).normalized();
-  }
-}
-
 std::vector<PosePair> pose_pool(double reach) {
-  std::mt19937_64 rng(2024);
+  Rng rng(2024);
   std::vector<PosePair> pool(4096);
   for (PosePair& p : pool) {
     p.a = {random_in_ball(rng, 10.0), random_rotation(rng)};

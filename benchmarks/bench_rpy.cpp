@@ -18,6 +18,7 @@
 
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/rpy_mobility.hpp"
+#include "stokescontact/scenes/sphere_packing.hpp"
 
 namespace {
 
@@ -30,16 +31,9 @@ using namespace stokescontact;
 constexpr double kFlopsPerPair = 69.0;
 
 std::vector<Pose> random_poses(Eigen::Index n, unsigned seed) {
-  const double side = std::cbrt(static_cast<double>(n) * 4.0 / 3.0 * std::numbers::pi / 0.24);
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, side);
-  std::normal_distribution<double> g(0.0, 1.0);
-  std::vector<Pose> poses(static_cast<std::size_t>(n));
-  for (Pose& p : poses) {
-    p.x = Vec3(u(rng), u(rng), u(rng));
-    p.q = Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
-  }
-  return poses;
+  Rng rng(seed);
+  const auto count = static_cast<std::size_t>(n);
+  return stokescontact::random_poses(count, 0.0, cube_side(count, 0.24), rng);
 }
 
 VecX random_forces(Eigen::Index size, unsigned seed) {

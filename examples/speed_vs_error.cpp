@@ -1,7 +1,7 @@
 // Speed versus error of every contact solver the library names (contact_solver_names) on the
 // same sphere scenes: the Fig. 4 suspensions (Broms & Tornberg Sec. 3.1.1; 500 unit spheres,
 // phi 0.24 and 0.12, random sequential addition) and a near-jammed packing (phi ~0.55, 200
-// spheres by default, by compression with overlap relaxation; sphere_packing.hpp). Same step
+// spheres by default, by compression with overlap relaxation; scenes/sphere_packing.hpp). Same step
 // as Fig. 4: d_hat = the minimum gap, |f_i| = 100, dt = 0.01, U = M f not counted.
 //
 //   speed_vs_error [--configs 20] [--seed 1] [--scenes fig4-0.24,fig4-0.12,jammed-0.55]

@@ -1,6 +1,6 @@
 #pragma once
 // One contact step on a scene of forced unit spheres, Broms & Tornberg Sec. 3.1.1: what the
-// sphere drivers share. A scene is a contact-free packing (sphere_packing.hpp) with
+// sphere drivers share. A scene is a contact-free packing (scenes/sphere_packing.hpp) with
 // d_hat = its minimum gap and forces of random direction, |f_i| = 100. The unconstrained
 // velocities U = M f cost one mobility application, not counted in the contact step; the step
 // itself (dt = 0.01, d^P, d_try of eq. 31 times a multiplier) is run by a contact solver
@@ -18,7 +18,7 @@
 #include <variant>
 #include <vector>
 
-#include "common/sphere_packing.hpp"
+#include "stokescontact/scenes/sphere_packing.hpp"
 
 namespace examples {
 
@@ -86,7 +86,7 @@ struct SceneSpec {
 
 struct SphereScene {
   std::uint64_t seed = 0;
-  SpherePacking packing;
+  sc::SpherePacking packing;
   std::vector<sc::Vec3> forces;
   double d_hat = 0.0;  // the minimum gap (Sec. 3.1.1)
 };
@@ -98,9 +98,9 @@ inline SphereScene make_scene(const SceneSpec& spec, std::uint64_t seed) {
   std::mt19937_64 rng(sequence);
   SphereScene s;
   s.seed = seed;
-  s.packing = spec.packing == PackingKind::dense ? dense_packing(spec.spheres, spec.phi, rng())
-                                                 : random_sequential_addition(spec.spheres, spec.phi, rng());
-  s.forces = random_forces(spec.spheres, kForceMagnitude, rng);
+  s.packing = spec.packing == PackingKind::dense ? sc::dense_packing(spec.spheres, spec.phi, rng())
+                                                 : sc::random_sequential_addition(spec.spheres, spec.phi, rng());
+  s.forces = sc::random_forces(spec.spheres, kForceMagnitude, rng);
   s.d_hat = s.packing.min_gap;
   return s;
 }

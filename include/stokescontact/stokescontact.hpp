@@ -45,6 +45,10 @@
 #include "stokescontact/mobility/sphere_shell.hpp"
 #include "stokescontact/mobility/thermal_drift.hpp"
 
+// scenes: seeded random poses, forces and sphere packings
+#include "stokescontact/scenes/random.hpp"
+#include "stokescontact/scenes/sphere_packing.hpp"
+
 // lcp (needs only core)
 #include "stokescontact/lcp/apgd.hpp"
 #include "stokescontact/lcp/bbpgd.hpp"

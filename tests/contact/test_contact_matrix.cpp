@@ -7,14 +7,14 @@
 #include <span>
 #include <vector>
 
-#include "contact/random_scenes.hpp"
+#include "common/test_support.hpp"
 #include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 
 namespace sc = stokescontact;
-using contact_test::expect_rejects;
-using contact_test::uniform;
-using contact_test::uniform_vector;
+using test_support::expect_rejects;
+using test_support::uniform;
+using test_support::uniform_vector;
 using sc::Pose;
 using sc::Vec3;
 using sc::VecX;
@@ -27,9 +27,8 @@ Vec3 torque(const sc::MatX& d, Eigen::Index k, Eigen::Index b) { return d.block<
 
 // A pose for body b near body a: centre at a random direction and distance in [lo, hi].
 Pose pose_nearby(std::mt19937_64& rng, const Pose& a, double lo, double hi) {
-  Vec3 dir = uniform_vector(rng, -1.0, 1.0);
-  while (dir.norm() < 0.1 || dir.norm() > 1.0) dir = uniform_vector(rng, -1.0, 1.0);
-  return {a.x + uniform(rng, lo, hi) * dir.normalized(), contact_test::random_rotation(rng)};
+  const Vec3 dir = test_support::random_unit_vector(rng);
+  return {a.x + uniform(rng, lo, hi) * dir, test_support::random_rotation(rng)};
 }
 
 VecX stack(const Vec3& ua, const Vec3& wa, const Vec3& ub, const Vec3& wb) {
@@ -48,7 +47,7 @@ void expect_rate_matches_finite_difference(const A& a, const B& b, double lo, do
   std::mt19937_64 rng(seed);
   int checked = 0;
   for (int trial = 0; trial < 150; ++trial) {
-    const Pose pa{uniform_vector(rng, -2.0, 2.0), contact_test::random_rotation(rng)};
+    const Pose pa{uniform_vector(rng, -2.0, 2.0), test_support::random_rotation(rng)};
     const Pose pb = pose_nearby(rng, pa, lo, hi);
     const VecX u = stack(uniform_vector(rng, -1, 1), uniform_vector(rng, -1, 1), uniform_vector(rng, -1, 1),
                          uniform_vector(rng, -1, 1));
@@ -119,7 +118,7 @@ void check_scene_columns(const S& shape, double box_length, int n, double d_try,
   const sc::SurfaceNodes nodes = sc::surface_nodes(shape, 0.15);
   for (const bool periodic : {false, true}) {
     std::mt19937_64 rng(seed);
-    const auto poses = contact_test::random_poses(rng, n, 0.0, box_length);
+    const auto poses = test_support::random_poses(n, 0.0, box_length, rng);
     std::optional<sc::PeriodicBox> box;
     if (periodic) box = sc::PeriodicBox{Vec3::Constant(box_length)};
     const auto pairs = sc::find_contact_pairs(shape, poses, d_try, box);
@@ -181,7 +180,7 @@ TEST(ContactMatrix, RateAcrossPeriodicBoundary) {
   const sc::Spherocylinder rod{2.0, 0.4};
   const sc::PeriodicBox box{Vec3::Constant(8.0)};
   std::mt19937_64 rng(107);
-  const auto poses = contact_test::random_poses(rng, 40, 0.0, 8.0);
+  const auto poses = test_support::random_poses(40, 0.0, 8.0, rng);
   const auto pairs = sc::find_contact_pairs(rod, poses, 0.4, box);
   const sc::MatX d(sc::contact_matrix(pairs, poses));
   const VecX u = VecX::NullaryExpr(6 * 40, [&] { return uniform(rng, -1, 1); });
@@ -208,7 +207,7 @@ TEST(ContactMatrix, PositiveMagnitudeSeparatesBodies) {
   const sc::Boomerang b = sc::broms_tornberg_boomerang();
   std::mt19937_64 rng(108);
   for (int trial = 0; trial < 50; ++trial) {
-    const Pose pa{Vec3::Zero(), contact_test::random_rotation(rng)};
+    const Pose pa{Vec3::Zero(), test_support::random_rotation(rng)};
     const Pose pb = pose_nearby(rng, pa, 1.0, 2.5);
     const std::vector<Pose> poses = {pa, pb};
     const std::vector<sc::ContactPair> pair = {{0, 1, Vec3::Zero(), sc::closest_points(b, pa, b, pb)}};
@@ -227,7 +226,7 @@ TEST(ContactMatrix, SphereColumnMatchesClosedForm) {
   const std::vector<sc::Sphere> spheres = {{0.5}, {0.8}};
   const Vec3 n = Vec3(1.0, -2.0, 0.5).normalized();
   std::mt19937_64 rng(109);
-  const std::vector<Pose> poses = {{Vec3(0.1, 0.2, 0.3), contact_test::random_rotation(rng)},
+  const std::vector<Pose> poses = {{Vec3(0.1, 0.2, 0.3), test_support::random_rotation(rng)},
                                    {Vec3(0.1, 0.2, 0.3) + 1.35 * n, sc::Quat::Identity()}};
   const auto pairs = sc::find_contact_pairs(std::span<const sc::Sphere>(spheres), poses, 0.1);
   ASSERT_EQ(pairs.size(), 1u);
@@ -275,7 +274,7 @@ TEST(ContactMatrix, SurfaceColumnOfSpheresIsCloseToParticleColumn) {
   const sc::SurfaceNodes nodes = sc::surface_nodes(s, 0.1);
   std::mt19937_64 rng(113);
   for (int trial = 0; trial < 20; ++trial) {
-    const Pose pa{uniform_vector(rng, -1, 1), contact_test::random_rotation(rng)};
+    const Pose pa{uniform_vector(rng, -1, 1), test_support::random_rotation(rng)};
     Pose pb = pose_nearby(rng, pa, 2.02, 2.1);
     const std::vector<Pose> poses = {pa, pb};
     const auto contacts = sc::find_surface_contacts(s, poses, nodes, 0.2);

@@ -8,12 +8,12 @@
 #include <span>
 #include <vector>
 
-#include "contact/random_scenes.hpp"
+#include "common/test_support.hpp"
 #include "stokescontact/contact/contact_pairs.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
 
 namespace sc = stokescontact;
-using contact_test::expect_rejects;
+using test_support::expect_rejects;
 using sc::Pose;
 using sc::Vec3;
 
@@ -73,7 +73,7 @@ void expect_flagged_equal_brute_force(std::span<const S> shapes, double box_leng
                                       std::uint64_t seed) {
   for (const bool periodic : {false, true}) {
     std::mt19937_64 rng(seed);
-    const auto poses = contact_test::random_poses(rng, n, 0.0, box_length);
+    const auto poses = test_support::random_poses(n, 0.0, box_length, rng);
     std::optional<sc::PeriodicBox> box;
     if (periodic) box = sc::PeriodicBox{Vec3::Constant(box_length)};
     const auto found = sc::find_contact_pairs(shapes, std::span<const Pose>(poses), d_try, box);
@@ -106,7 +106,7 @@ TEST(ContactPairs, SpheresMatchBruteForce) {
   for (const std::uint64_t seed : {11u, 12u}) {
     std::mt19937_64 rng(seed + 1000);
     std::vector<sc::Sphere> spheres(120);
-    for (auto& s : spheres) s.radius = contact_test::uniform(rng, 0.3, 0.7);
+    for (auto& s : spheres) s.radius = test_support::uniform(rng, 0.3, 0.7);
     expect_flagged_equal_brute_force(std::span<const sc::Sphere>(spheres), 10.0, 120, 0.3, seed);
   }
 }
@@ -143,7 +143,7 @@ TEST(ContactPairs, PeriodicPairUsesMinimumImage) {
 TEST(ContactPairs, MinimumDistanceOfSparseScenes) {
   const sc::Sphere unit{1.0};
   std::mt19937_64 rng(41);
-  const auto spread = contact_test::random_poses(rng, 6, -1000.0, 1000.0);
+  const auto spread = test_support::random_poses(6, -1000.0, 1000.0, rng);
   EXPECT_EQ(sc::minimum_pair_distance(unit, spread).distance,
             brute_minimum(std::span<const sc::Sphere>(&unit, 1), std::span<const Pose>(spread), std::nullopt));
 
@@ -169,7 +169,7 @@ TEST(ContactPairs, ReusedCellListGivesSameResults) {
   sc::CellList cells;
   for (const std::uint64_t seed : {51u, 52u, 53u}) {
     std::mt19937_64 rng(seed);
-    const auto poses = contact_test::random_poses(rng, 40, 0.0, 10.0);
+    const auto poses = test_support::random_poses(40, 0.0, 10.0, rng);
     const auto fresh = sc::find_contact_pairs(boomerang, poses, 0.3);
     const auto reused = sc::find_contact_pairs(boomerang, poses, 0.3, std::nullopt, &cells);
     ASSERT_EQ(fresh.size(), reused.size()) << "seed " << seed;
@@ -185,7 +185,7 @@ TEST(ContactPairs, SurfaceContactsFollowFlaggedPairs) {
   const sc::SurfaceNodes nodes = sc::surface_nodes(rod, 0.2);
   const sc::PeriodicBox box{Vec3::Constant(9.0)};
   std::mt19937_64 rng(61);
-  const auto poses = contact_test::random_poses(rng, 50, 0.0, 9.0);
+  const auto poses = test_support::random_poses(50, 0.0, 9.0, rng);
   const auto pairs = sc::find_contact_pairs(rod, poses, 0.3, box);
   const auto contacts = sc::find_surface_contacts(rod, poses, nodes, 0.3, box);
   ASSERT_EQ(contacts.size(), pairs.size());

@@ -14,7 +14,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "contact/random_scenes.hpp"
+#include "common/test_support.hpp"
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/solvers/barrier_nlopt.hpp"
 #include "stokescontact/contact/solvers/defect_correction.hpp"

@@ -5,11 +5,11 @@
 #include <random>
 #include <vector>
 
-#include "contact/random_scenes.hpp"
+#include "common/test_support.hpp"
 #include "stokescontact/contact/d_try.hpp"
 
 namespace sc = stokescontact;
-using contact_test::expect_rejects;
+using test_support::expect_rejects;
 using sc::Pose;
 using sc::Vec3;
 using sc::VecX;
@@ -40,8 +40,8 @@ TEST(DTry, RodTakesFasterTip) {
   // Rotated: tips at x +- R e_z; the faster of u +- omega x (R e_z).
   std::mt19937_64 rng(201);
   for (int trial = 0; trial < 20; ++trial) {
-    const std::vector<Pose> poses = contact_test::random_poses(rng, 3, -5.0, 5.0);
-    const VecX vel = VecX::NullaryExpr(18, [&] { return contact_test::uniform(rng, -2, 2); });
+    const std::vector<Pose> poses = test_support::random_poses(3, -5.0, 5.0, rng);
+    const VecX vel = VecX::NullaryExpr(18, [&] { return test_support::uniform(rng, -2, 2); });
     double fastest = 0.0;
     for (int k = 0; k < 3; ++k) {
       const Vec3 arm = poses[static_cast<std::size_t>(k)].q * Vec3(0, 0, 1.0);
@@ -64,8 +64,8 @@ TEST(DTry, BoomerangBoundsEveryCentreCurvePoint) {
     for (int i = 0; i <= 200; ++i) samples.push_back(a.point(a.angle * i / 200.0));
   std::mt19937_64 rng(202);
   for (int trial = 0; trial < 50; ++trial) {
-    const std::vector<Pose> poses = contact_test::random_poses(rng, 1, -5.0, 5.0);
-    const VecX vel = VecX::NullaryExpr(6, [&] { return contact_test::uniform(rng, -2, 2); });
+    const std::vector<Pose> poses = test_support::random_poses(1, -5.0, 5.0, rng);
+    const VecX vel = VecX::NullaryExpr(6, [&] { return test_support::uniform(rng, -2, 2); });
     const Vec3 v = vel.head<3>(), w = vel.tail<3>();
     double sampled = 0.0;
     for (const Vec3& r : samples) sampled = std::max(sampled, (v + w.cross(poses[0].q * r)).norm());

@@ -14,15 +14,9 @@ namespace sc = stokescontact;
 namespace {
 
 using test_support::expect_rejects;
-using test_support::random_rotation;
+using test_support::random_poses;
 using test_support::uniform;
 using test_support::uniform_vector;
-
-std::vector<sc::Pose> random_poses(test_support::Rng& rng, int n) {
-  std::vector<sc::Pose> poses(static_cast<std::size_t>(n));
-  for (auto& p : poses) p = {uniform_vector(rng, -5, 5), random_rotation(rng)};
-  return poses;
-}
 
 // Half the curl of u by central differences (exact for a linear u up to rounding).
 sc::Vec3 half_curl_by_differences(const sc::LinearBackgroundFlow& flow, const sc::Vec3& x) {
@@ -39,7 +33,7 @@ TEST(BackgroundFlow, ShearMovesWithRateTimesYAndSpinsWithMinusHalfRateAboutZ) {
   const double rate = 2.5;
   const sc::LinearBackgroundFlow flow = sc::LinearBackgroundFlow::shear(rate);
   test_support::Rng rng(11);
-  const std::vector<sc::Pose> poses = random_poses(rng, 7);
+  const std::vector<sc::Pose> poses = random_poses(7, -5.0, 5.0, rng);
   EXPECT_EQ(flow.angular_velocity(), sc::Vec3(0, 0, -0.5 * rate));
   for (const int dofs : {3, 6}) {
     SCOPED_TRACE(dofs);
@@ -66,7 +60,7 @@ TEST(BackgroundFlow, BiaxialCompressionIsTracelessIrrotationalAndMatchesEq32) {
   EXPECT_EQ(flow.velocity_gradient().trace(), 0.0);
   EXPECT_EQ(flow.angular_velocity(), sc::Vec3::Zero());
   test_support::Rng rng(12);
-  const std::vector<sc::Pose> poses = random_poses(rng, 5);
+  const std::vector<sc::Pose> poses = random_poses(5, -5.0, 5.0, rng);
   const sc::VecX U = flow.body_velocities(poses, 6);
   for (std::size_t b = 0; b < poses.size(); ++b) {
     const sc::Vec3& x = poses[b].x;

@@ -4,39 +4,21 @@
 
 #include <cstddef>
 #include <random>
-#include <vector>
 
 #include <Eigen/Eigenvalues>
 
-#include "stokescontact/core/pose.hpp"
 #include "stokescontact/mobility/mobility_operator.hpp"
+#include "stokescontact/scenes/random.hpp"
 
 namespace mobility_checks {
 
 namespace sc = stokescontact;
 
-inline sc::Quat random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  return sc::Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
-}
-
 inline double min_eigenvalue(const sc::MatX& m) {
   return Eigen::SelfAdjointEigenSolver<sc::MatX>(m, Eigen::EigenvaluesOnly).eigenvalues()(0);
 }
 
-// Centres uniform in a cube of side `box` (overlaps allowed), orientations uniform (a
-// normalised Gaussian quaternion).
-inline std::vector<sc::Pose> random_poses(std::size_t n, double box, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(0.0, box);
-  std::vector<sc::Pose> poses(n);
-  for (sc::Pose& p : poses) {
-    p.x = sc::Vec3(u(rng), u(rng), u(rng));
-    p.q = random_rotation(rng);
-  }
-  return poses;
-}
-
-inline sc::VecX random_vector(Eigen::Index n, std::mt19937& rng) {
+inline sc::VecX random_vector(Eigen::Index n, sc::Rng& rng) {
   std::normal_distribution<double> g(0.0, 1.0);
   sc::VecX v(n);
   for (Eigen::Index i = 0; i < n; ++i) v(i) = g(rng);
@@ -47,7 +29,7 @@ inline sc::VecX random_vector(Eigen::Index n, std::mt19937& rng) {
 // matrix costs no application, each apply counts one, zero force gives exactly zero, and
 // reset_applications() clears the count. The model must be configured.
 template <sc::DenseMobilityOperator M>
-void expect_apply_matches_dense(M& m, std::mt19937& rng, double tolerance) {
+void expect_apply_matches_dense(M& m, sc::Rng& rng, double tolerance) {
   std::normal_distribution<double> g(0.0, 1.0);
   m.reset_applications();
   const sc::MatX dense = m.dense_matrix();

@@ -20,22 +20,22 @@ static_assert(sc::DenseMobilityOperator<sc::FreeDrainingMobility>);
 namespace {
 
 using mobility_checks::min_eigenvalue;
-using mobility_checks::random_poses;
-using mobility_checks::random_rotation;
+using sc::random_poses;
+using sc::random_rotation;
 using mobility_checks::random_vector;
 
 constexpr double kPi = std::numbers::pi;
 constexpr unsigned kSeed = 20240611;
 
 // An SPD 6x6 with translation-rotation coupling, as a multiblob model of an irregular body gives.
-sc::Mat6 random_body_mobility(std::mt19937& rng) {
+sc::Mat6 random_body_mobility(sc::Rng& rng) {
   const sc::VecX a = random_vector(36, rng);
   const sc::Mat6 A = Eigen::Map<const sc::Mat6>(a.data());
   return A * A.transpose() + 0.5 * sc::Mat6::Identity();
 }
 
 // Three shapes: a sphere, a slender rod, an irregular body with coupling.
-sc::FreeDrainingMobility mixed_scene(std::size_t bodies, int dofs, std::mt19937& rng) {
+sc::FreeDrainingMobility mixed_scene(std::size_t bodies, int dofs, sc::Rng& rng) {
   std::vector<sc::Mat6> shapes{sc::sphere_mobility({0.7}, 1.3), sc::spherocylinder_mobility({4.0, 0.5}, 1.3),
                                random_body_mobility(rng)};
   std::vector<std::size_t> shape_of_body(bodies);
@@ -87,8 +87,8 @@ TEST(SingleBodyMobility, SpherocylinderRefusesStubbyRods) {
 
 TEST(FreeDrainingMobility, SphereSceneIsStokesEinsteinInBothModels) {
   const double a = 1.1, eta = 0.6;
-  std::mt19937 rng(kSeed);
-  const std::vector<sc::Pose> poses = random_poses(50, 10.0, rng);
+  sc::Rng rng(kSeed);
+  const std::vector<sc::Pose> poses = random_poses(50, 0.0, 10.0, rng);
   for (int dofs : {3, 6}) {
     sc::FreeDrainingMobility m(sc::sphere_mobility({a}, eta), poses.size(), dofs);
     m.set_configuration(poses);
@@ -116,10 +116,10 @@ TEST(FreeDrainingMobility, RodBlockIsRotatedWithItsPose) {
 }
 
 TEST(FreeDrainingMobility, DenseMatrixIsSymmetricPositiveDefinite) {
-  std::mt19937 rng(kSeed);
+  sc::Rng rng(kSeed);
   for (int dofs : {3, 6}) {
     sc::FreeDrainingMobility m = mixed_scene(30, dofs, rng);
-    m.set_configuration(random_poses(30, 5.0, rng));
+    m.set_configuration(random_poses(30, 0.0, 5.0, rng));
     const sc::MatX M = m.dense_matrix();
     EXPECT_LT((M - M.transpose()).cwiseAbs().maxCoeff(), 1e-15 * M.cwiseAbs().maxCoeff()) << "seed " << kSeed;
     EXPECT_EQ(Eigen::LLT<sc::MatX>(M).info(), Eigen::Success) << "seed " << kSeed;
@@ -128,21 +128,21 @@ TEST(FreeDrainingMobility, DenseMatrixIsSymmetricPositiveDefinite) {
 }
 
 TEST(FreeDrainingMobility, ApplyEqualsDenseMatrixAndCountsApplications) {
-  std::mt19937 rng(kSeed + 1);
+  sc::Rng rng(kSeed + 1);
   for (int dofs : {3, 6}) {
     SCOPED_TRACE("seed " + std::to_string(kSeed + 1) + ", dofs " + std::to_string(dofs));
     sc::FreeDrainingMobility m = mixed_scene(40, dofs, rng);
-    m.set_configuration(random_poses(40, 5.0, rng));
+    m.set_configuration(random_poses(40, 0.0, 5.0, rng));
     mobility_checks::expect_apply_matches_dense(m, rng, 1e-13);
   }
 }
 
 // Rotating and shifting the whole scene rotates every block: M' = Q M Q^T.
 TEST(FreeDrainingMobility, RigidMotionOfSceneRotatesMobility) {
-  std::mt19937 rng(kSeed + 2);
+  sc::Rng rng(kSeed + 2);
   for (int dofs : {3, 6}) {
     sc::FreeDrainingMobility m = mixed_scene(12, dofs, rng);
-    std::vector<sc::Pose> poses = random_poses(12, 5.0, rng);
+    std::vector<sc::Pose> poses = random_poses(12, 0.0, 5.0, rng);
     m.set_configuration(poses);
     const sc::MatX M = m.dense_matrix();
     const sc::Quat q = random_rotation(rng);
@@ -161,9 +161,9 @@ TEST(FreeDrainingMobility, RigidMotionOfSceneRotatesMobility) {
 
 // The translation-only model is the translation block of the full one (exact when torque-free).
 TEST(FreeDrainingMobility, ThreeDofModelIsTranslationBlockOfSixDofModel) {
-  std::mt19937 rng(kSeed + 3);
-  const std::vector<sc::Pose> poses = random_poses(9, 5.0, rng);
-  std::mt19937 shapes_rng(7);
+  sc::Rng rng(kSeed + 3);
+  const std::vector<sc::Pose> poses = random_poses(9, 0.0, 5.0, rng);
+  sc::Rng shapes_rng(7);
   sc::FreeDrainingMobility m3 = mixed_scene(9, 3, shapes_rng);
   shapes_rng.seed(7);
   sc::FreeDrainingMobility m6 = mixed_scene(9, 6, shapes_rng);

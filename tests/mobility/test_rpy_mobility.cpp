@@ -24,8 +24,8 @@ static_assert(sc::DenseMobilityOperator<sc::RpyMobility>);
 namespace {
 
 using mobility_checks::min_eigenvalue;
-using mobility_checks::random_poses;
-using mobility_checks::random_rotation;
+using sc::random_poses;
+using sc::random_rotation;
 using mobility_checks::random_vector;
 
 constexpr double kPi = std::numbers::pi;
@@ -92,7 +92,7 @@ TEST(RpyPairBlocks, CoincidentLimitIsSelfMobility) {
 // (Faxen), for the flow of a force (giving M_rt) and of a torque (u = M_rt tau, giving M_rr).
 TEST(RpyPairBlocks, FarRotationBlocksAreHalfCurlOfTheFlow) {
   const double a = 0.5, eta = 1.7;
-  std::mt19937 rng(kSeed);
+  sc::Rng rng(kSeed);
   for (int trial = 0; trial < 5; ++trial) {
     sc::Vec3 r = random_vector(3, rng);
     r *= (2.5 + trial) * a / r.norm();
@@ -126,11 +126,11 @@ TEST(RpyMobility, SingleSphereIsStokesEinstein) {
 
 // Random configurations with many overlaps: M stays SPD (Wajnryb et al.'s point).
 TEST(RpyMobility, DenseMatrixIsSymmetricPositiveDefiniteWithOverlaps) {
-  std::mt19937 rng(kSeed + 1);
+  sc::Rng rng(kSeed + 1);
   for (int dofs : {3, 6}) {
     for (double box : {3.0, 8.0}) {  // 40 unit spheres in a box of side 3: heavy overlap
       sc::RpyMobility m(40, {1.0, 1.0}, dofs);
-      const std::vector<sc::Pose> poses = random_poses(40, box, rng);
+      const std::vector<sc::Pose> poses = random_poses(40, 0.0, box, rng);
       m.set_configuration(poses);
       const sc::MatX M = m.dense_matrix();
       const std::string info = "seed " + std::to_string(kSeed + 1) + ", dofs " + std::to_string(dofs) +
@@ -143,25 +143,24 @@ TEST(RpyMobility, DenseMatrixIsSymmetricPositiveDefiniteWithOverlaps) {
 }
 
 TEST(RpyMobility, ApplyEqualsDenseMatrixAndCountsApplications) {
-  std::mt19937 rng(kSeed + 2);
+  sc::Rng rng(kSeed + 2);
   for (int dofs : {3, 6}) {
     SCOPED_TRACE("seed " + std::to_string(kSeed + 2) + ", dofs " + std::to_string(dofs));
     // 300 spheres: two target blocks, the second partial; overlapping and distant pairs.
     sc::RpyMobility m(300, {0.8, 0.5}, dofs);
-    m.set_configuration(random_poses(300, 8.0, rng));
+    m.set_configuration(random_poses(300, 0.0, 8.0, rng));
     mobility_checks::expect_apply_matches_dense(m, rng, 1e-13);
   }
 }
 
 TEST(RpyMobility, RigidMotionOfSceneRotatesMobility) {
-  std::mt19937 rng(kSeed + 3);
-  std::normal_distribution<double> g(0.0, 1.0);
+  sc::Rng rng(kSeed + 3);
   for (int dofs : {3, 6}) {
     sc::RpyMobility m(20, {1.0, 1.0}, dofs);
-    std::vector<sc::Pose> poses = random_poses(20, 5.0, rng);
+    std::vector<sc::Pose> poses = random_poses(20, 0.0, 5.0, rng);
     m.set_configuration(poses);
     const sc::MatX M = m.dense_matrix();
-    const sc::Quat q = sc::Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
+    const sc::Quat q = random_rotation(rng);
     for (sc::Pose& p : poses) {
       p.x = q * p.x + sc::Vec3(-4.0, 1.0, 7.0);
       p.q = q * p.q;
@@ -178,8 +177,8 @@ TEST(RpyMobility, RigidMotionOfSceneRotatesMobility) {
 
 // The translation-only model is the translation block of the full one.
 TEST(RpyMobility, ThreeDofModelIsTranslationBlockOfSixDofModel) {
-  std::mt19937 rng(kSeed + 4);
-  const std::vector<sc::Pose> poses = random_poses(60, 4.0, rng);
+  sc::Rng rng(kSeed + 4);
+  const std::vector<sc::Pose> poses = random_poses(60, 0.0, 4.0, rng);
   sc::RpyMobility m3(60, {1.0, 0.7}, 3), m6(60, {1.0, 0.7}, 6);
   m3.set_configuration(poses);
   m6.set_configuration(poses);
@@ -198,9 +197,9 @@ TEST(RpyMobility, ThreeDofModelIsTranslationBlockOfSixDofModel) {
 #ifdef _OPENMP
 // Each target sums its sources in one order, whatever the number of threads.
 TEST(RpyMobility, ApplyDoesNotDependOnThreadCount) {
-  std::mt19937 rng(kSeed + 5);
+  sc::Rng rng(kSeed + 5);
   sc::RpyMobility m(700, {1.0, 1.0}, 6);
-  m.set_configuration(random_poses(700, 12.0, rng));
+  m.set_configuration(random_poses(700, 0.0, 12.0, rng));
   const sc::VecX F = random_vector(m.size(), rng);
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);

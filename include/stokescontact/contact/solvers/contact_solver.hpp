@@ -106,7 +106,9 @@ inline std::string contact_solver_name(const ContactSolver& solver) {
             case InnerLcpSolver::minimum_map_newton: return "lcp-newton";
           }
           return "lcp";
-        } else {
+        }
+#if STOKESCONTACT_HAS_NLOPT
+        else {
           switch (o.optimizer) {
             case BarrierOptimizer::slsqp: return "barrier-slsqp";
             case BarrierOptimizer::mma: return "barrier-mma";
@@ -114,6 +116,7 @@ inline std::string contact_solver_name(const ContactSolver& solver) {
           }
           return "barrier";
         }
+#endif
       },
       solver);
 }
@@ -150,8 +153,10 @@ ContactStepResult solve_contact_step(const ContactStepProblem<S>& problem, M& mo
           return solve_contact_step_defect_correction(problem, mobility, options, o);
         else if constexpr (std::is_same_v<O, LcpSequenceOptions>)
           return solve_contact_step_lcp_sequence(problem, mobility, options, o);
+#if STOKESCONTACT_HAS_NLOPT
         else
           return solve_contact_step_barrier(problem, mobility, options, o);
+#endif
       },
       solver);
 }
