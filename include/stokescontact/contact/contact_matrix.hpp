@@ -1,7 +1,7 @@
 #pragma once
 // The contact matrix D (Broms & Tornberg eq. 18-23; Yan et al. eq. 31-32), sparse,
 // (dofs_per_body N) x Nc: column k maps the magnitude lambda_k of contact k, between bodies
-// i < j, to the forces and torques on them, F_c = D lambda (eq. 6). Rows follow the
+// i < j, to the forces and torques on them, F_c = D lambda (Broms eq. 6). Rows follow the
 // mobility layout: body b owns rows [b d, (b + 1) d), (force, torque) for d = 6, the force
 // alone for d = 3 (the translation-only variant, for spheres, whose contact forces pass
 // through their centres: the torques are dropped).
@@ -14,15 +14,15 @@
 //     D^T U = dd/dt   for U = (u_1, omega_1, ..., u_N, omega_N)   (Yan eq. 38: grad Phi = D^T),
 // so lambda >= 0 pushes the bodies apart, and each column obeys Newton's third law (forces
 // sum to zero; torques about any point sum to (p_j - p_i) x n = d n x n = 0). This is Broms
-// eq. 18, D = -grad B = -b'(d) grad d with b' < 0, normalised as in eq. 20. (Eq. 21 and 23
+// eq. 18, D = -grad B = -b'(d) grad d with b' < 0, normalised as in Broms eq. 20. (Broms eq. 21 and 23
 // as printed write the torques as n x s, the opposite sign of s x f; we keep s x f, which the
 // finite-difference test of D^T U against dd/dt confirms.)
 //
-// d^P (eq. 20-21): one point pair per contact, the closest points; the force has unit norm.
-// d^S (eq. 22-23): the sum over the contact's node pairs l of w_l (gradient of d_l), with
+// d^P (Broms eq. 20-21): one point pair per contact, the closest points; the force has unit norm.
+// d^S (Broms eq. 22-23): the sum over the contact's node pairs l of w_l (gradient of d_l), with
 // weights w_l = -b'(d_l) of a barrier with threshold d_try (b0 by default: w_l = 1/d_l as in
 // the paper, regularised by eps_reg / eps_cap so overlapping node pairs get finite weights),
-// divided by the norm of the net force |sum_l w_l n_l| as eq. 20 does: lambda is then the
+// divided by the norm of the net force |sum_l w_l n_l| as Broms eq. 20 does: lambda is then the
 // magnitude of the net contact force in both variants, independent of the number of nodes
 // and of the barrier's scale. Where the node forces nearly cancel (a body squeezed from
 // opposite sides) that norm is floored at min_net_force_fraction * sum_l w_l, so the column
@@ -56,10 +56,10 @@ struct ContactColumn {
   Vec3 torque_j = Vec3::Zero();
 };
 
-// How the node pairs of a surface contact are weighted (eq. 23).
+// How the node pairs of a surface contact are weighted (Broms eq. 23).
 struct SurfaceWeights {
   BarrierFunction function = BarrierFunction::b0;  // w_l = -b'(d_l), threshold d_try
-  double eps_reg = 0.0;                            // shift of the weight barrier (Remark 4)
+  double eps_reg = 0.0;                            // shift of the weight barrier (Broms Remark 4)
   double cap_fraction = 1e-2;                      // its cap at cap_fraction (d_try + eps_reg)
   double min_net_force_fraction = 1e-3;            // floor of the normalisation, in (0, 1]
 };
@@ -173,12 +173,12 @@ inline Eigen::SparseMatrix<double> assemble_contact_matrix(std::span<const Conta
   return d;
 }
 
-// eq. 20-21: the column of a pair from its closest points.
+// Broms eq. 20-21: the column of a pair from its closest points.
 inline ContactColumn particle_contact_column(const ContactPair& pair, std::span<const Pose> poses) {
   return detail::particle_contact_column(pair, poses, "pair");
 }
 
-// eq. 22-23: the weighted, normalised column of a surface contact; d_try > 0 is the
+// Broms eq. 22-23: the weighted, normalised column of a surface contact; d_try > 0 is the
 // threshold its node pairs were found with.
 inline ContactColumn surface_contact_column(const SurfaceContact& contact, std::span<const Pose> poses, double d_try,
                                             const SurfaceWeights& weights = {}) {
@@ -186,7 +186,7 @@ inline ContactColumn surface_contact_column(const SurfaceContact& contact, std::
                                         "contact");
 }
 
-// D from closest points (eq. 20-21), one column per pair.
+// D from closest points (Broms eq. 20-21), one column per pair.
 inline Eigen::SparseMatrix<double> contact_matrix(std::span<const ContactPair> pairs, std::span<const Pose> poses,
                                                   int dofs_per_body = 6) {
   std::vector<ContactColumn> columns;
@@ -196,7 +196,7 @@ inline Eigen::SparseMatrix<double> contact_matrix(std::span<const ContactPair> p
   return assemble_contact_matrix(columns, poses.size(), dofs_per_body);
 }
 
-// D from surface-node distances (eq. 22-23), one column per contact.
+// D from surface-node distances (Broms eq. 22-23), one column per contact.
 inline Eigen::SparseMatrix<double> surface_contact_matrix(std::span<const SurfaceContact> contacts,
                                                           std::span<const Pose> poses, double d_try,
                                                           int dofs_per_body = 6, const SurfaceWeights& weights = {}) {

@@ -7,8 +7,9 @@
 // Nc pairs with d^P <= d_try (eq. 30/31) and builds the contact matrix D at Q*: from the
 // closest points (d^P, eq. 20-21) or from the surface-node pairs within d_try (d^S, eq.
 // 22-23; by default for boomerangs, whose non-convex contacts may touch at several places).
-// The constraint is on d^P in both cases (d^S <= d^P for every node pair, Sec. 3.2.1, so
-// d^P >= d_hat is the stricter); d^S only spreads each contact's force over its node pairs.
+// The constraint is on d^P in both cases (d^S >= d^P for every node pair, Sec. 3.2.1, which
+// prints the inequality reversed; so d^P >= d_hat is the stricter); d^S only spreads each
+// contact's force over its node pairs.
 // A solver then looks for contact magnitudes lambda >= 0 so that the corrected configuration
 //     Q(lambda) = Q_t + dt Psi (U + M D lambda)        (eq. 13, M at Q_t)
 // keeps every pair at d >= d_hat. Two cost modes for M D lambda:
@@ -256,7 +257,7 @@ class ContactStep {
     return contact_matrix(std::span<const ContactPair>(e.pairs), std::span<const Pose>(e.poses), dofs_);
   }
 
-  // The barrier of eq. 15: b of eq. 10 with eps_reg = d_try (Remark 4).
+  // The barrier of eq. 15: b of eq. 10 with eps_reg = d_try (Remark 4; the value is Sec. 2.3's).
   BarrierParameters barrier_parameters_eq15() const { return barrier_parameters(problem_.d_hat, d_try_); }
 
   bool separated(double d) const { return d >= problem_.d_hat * (1.0 - options_.separation_margin); }

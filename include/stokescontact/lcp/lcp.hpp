@@ -2,7 +2,7 @@
 // The linear complementarity problem of a contact step (Yan et al. eq. 39-41):
 //     find gamma with  0 <= gamma  _|_  w = A gamma + b >= 0,   A = D^T M D (symmetric PSD),
 // equivalently the convex quadratic programme min_{gamma >= 0} 1/2 gamma^T A gamma + b^T gamma
-// (eq. 42). A is matrix-free: a callable VecX -> VecX (one call = one mobility application in
+// (Yan eq. 42). A is matrix-free: a callable VecX -> VecX (one call = one mobility application in
 // the caller's accounting), or any Eigen matrix with A * x (each product is still counted).
 //
 // Residual and stopping rule, shared by every solver. The minimum map H = min(gamma, w)

@@ -1,7 +1,7 @@
 #pragma once
 // The barrier method of Broms & Tornberg (eq. 15) with NLopt:
 //     min_{lambda >= 0} sum_k lambda_k   s.t.   E(lambda) = sum_k b(d_k(Q(lambda))) = 0,
-// b of eq. 10 with eps_reg = d_try by default (Remark 4, the paper's choice; eps_cap = 1e-2
+// b of eq. 10 with eps_reg = d_try by default (Remark 4; Sec. 2.3, the paper's choice; eps_cap = 1e-2
 // (d_hat + eps_reg) keeps b finite for overlaps), Q(lambda) = Q_t + dt Psi (U + M D lambda).
 // Since b >= 0, E = 0 is posed as the inequality E <= 0 (the same feasible set; MMA accepts
 // only inequalities).
@@ -49,7 +49,7 @@ struct BarrierNloptOptions {
   BarrierOptimizer optimizer = BarrierOptimizer::slsqp;
   BarrierObjective objective = BarrierObjective::lambda_sum;
   double tol = 1e-2;                 // eq. 29
-  double eps_reg = -1.0;             // < 0: d_try (Remark 4)
+  double eps_reg = -1.0;             // < 0: d_try (Remark 4, Sec. 2.3)
   int max_evaluations = 1000;        // barrier-energy evaluations per round
   double cap_fraction = 1e-2;        // eps_cap = cap_fraction (d_hat + eps_reg)
 

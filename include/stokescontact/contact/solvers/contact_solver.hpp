@@ -3,9 +3,9 @@
 //
 // A `ContactSolver` is the options struct of one of the library's solvers; which alternative
 // it holds says which solver runs:
-//   DefectCorrectionOptions   the default: eq. 27 by defect correction (defect_correction.hpp)
+//   DefectCorrectionOptions   the default: Broms eq. 27 by defect correction (defect_correction.hpp)
 //   LcpSequenceOptions        the NCP as a sequence of LCPs (Lu et al. Alg. 1; lcp_sequence.hpp)
-//   BarrierNloptOptions       the barrier method, eq. 15 with NLopt (barrier_nlopt.hpp); only
+//   BarrierNloptOptions       the barrier method, Broms eq. 15 with NLopt (barrier_nlopt.hpp); only
 //                             where the library was configured with NLopt
 //                             (STOKESCONTACT_HAS_NLOPT)
 // Every solver returns the same ContactStepResult. Drivers and scene files name a solver by a
@@ -121,7 +121,7 @@ inline std::string contact_solver_name(const ContactSolver& solver) {
       solver);
 }
 
-// The eq. 29 stopping tolerance TOL of a solver that has one (default, barrier); the LCP
+// The Broms eq. 29 stopping tolerance TOL of a solver that has one (default, barrier); the LCP
 // sequence's own stops at its first separated iterate by default (tol = 0), so it reports none.
 inline std::optional<double> stopping_tolerance(const ContactSolver& solver) {
   return std::visit(
@@ -134,7 +134,7 @@ inline std::optional<double> stopping_tolerance(const ContactSolver& solver) {
       solver);
 }
 
-// Sets TOL (eq. 29) on any solver: the LCP sequence then iterates to it as well.
+// Sets TOL (Broms eq. 29) on any solver: the LCP sequence then iterates to it as well.
 inline void set_stopping_tolerance(ContactSolver& solver, double tol) {
   require_positive(tol, "tol");
   std::visit([tol](auto& o) { o.tol = tol; }, solver);

@@ -1,12 +1,12 @@
 #pragma once
-// The default contact solver: the complementarity problem of eq. 27,
+// The default contact solver: the complementarity problem of Broms & Tornberg eq. 27,
 //     0 <= lambda  _|_  d(lambda) - d_hat (1 + margin) >= 0,   d = d^P(Q(lambda)),
 // solved by defect correction with a probed Delassus matrix. Its solution is also the one of
-// the barrier method (eq. 15): no pair below d_hat, and a force only on pairs held at the
+// the barrier method (Broms eq. 15): no pair below d_hat, and a force only on pairs held at the
 // threshold, so no force larger than needed.
 //
 // Why it is cheap. Of the Nc pairs flagged by d_try, only the few that the trial step brings
-// below d_hat need a force (in the Fig. 4 scenes ~4% of them), and those are spread through the
+// below d_hat need a force (in the Broms Fig. 4 scenes ~4% of them), and those are spread through the
 // suspension. We keep a working set W of those pairs (and of any pair a correction brings below
 // the threshold) and approximate A = dt D^T M D on W by probing (delassus_probing.hpp):
 // contacts far apart share one mobility application. Each iteration then solves the LCP of the
@@ -14,12 +14,12 @@
 // mobility applications),
 //     0 <= lambda_W  _|_  d_W(lambda_k) + A~ (lambda_W - lambda_k,W) - d_hat (1 + margin) >= 0,
 // and measures the true distances at the new lambda: one application for M D lambda. The true
-// d(lambda_k) enters every model, so a fixed point solves eq. 27 exactly whatever A~ is; the
+// d(lambda_k) enters every model, so a fixed point solves Broms eq. 27 exactly whatever A~ is; the
 // probing error (far-field coupling, a few per cent) sets the contraction rate per iteration.
 // For spheres the linear model underestimates each centre distance (it is convex in the
 // displacements), which keeps the iterates on the separated side.
 //
-// Refinements, each measured on the Fig. 4 scenes or a hard case in the tests:
+// Refinements, each measured on the Broms Fig. 4 scenes or a hard case in the tests:
 //  - pairs outside W that the model predicts the new lambda brings below the target join W
 //    before the distances are measured (their rows come free with the probes);
 //  - from the second correction on, each measured step (delta lambda, delta d) corrects A~ by
@@ -30,7 +30,7 @@
 //    dense clusters, whose many far fields add up), the round is finished by the LCP sequence
 //    with exact products, polished to complementarity (solver_lcp_sequence.hpp).
 //
-// Stopping rule (eq. 29 form): at an iterate whose flagged pairs all have d >= d_hat, stop when
+// Stopping rule (Broms eq. 29 form): at an iterate whose flagged pairs all have d >= d_hat, stop when
 // the next correction would change lambda by less than tol ||lambda||_inf; that iterate is
 // returned, so separation is measured, never predicted. The margin puts roundoff and the
 // remaining probing error on the separated side; it costs a relative force excess of about
@@ -60,7 +60,7 @@ namespace stokescontact {
 
 struct DefectCorrectionOptions {
   double margin = 1e-4;               // target d_hat (1 + margin)
-  double tol = 1e-4;                  // eq. 29 rule on successive corrections
+  double tol = 1e-4;                  // Broms eq. 29 rule on successive corrections
   double probe_radius_factor = 4.0;   // probe radius = factor x the largest bounding radius
   int max_iterations = 50;            // corrections per round
   double contraction = 0.5;           // a correction must shrink the shortfall by this factor ...
@@ -212,7 +212,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
     }
     const double change = (next - lambda).lpNorm<Eigen::Infinity>();
     const double scale = std::max(next.lpNorm<Eigen::Infinity>(), lambda.lpNorm<Eigen::Infinity>());
-    if (e.min_distance() >= d_hat && change <= options.tol * scale) {  // eq. 29 at a separated iterate
+    if (e.min_distance() >= d_hat && change <= options.tol * scale) {  // Broms eq. 29 at a separated iterate
       out.converged = true;
       break;
     }

@@ -1,5 +1,5 @@
 #pragma once
-// A local approximation of the Delassus matrix A = dt D^T M D (the LCP matrix of eq. 26 with
+// A local approximation of the Delassus matrix A = dt D^T M D (the LCP matrix of Broms eq. 26 with
 // d^P) on a working set of contacts, from a few mobility applications ("probing").
 //
 // Column c of A costs one application, M D e_c. But M D e_c is a force dipole's response: its

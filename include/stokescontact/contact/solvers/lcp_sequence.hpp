@@ -1,7 +1,7 @@
 #pragma once
 // The contact step as a sequence of LCPs (Lu et al. Alg. 1; Broms & Tornberg eq. 25-27 with d^P).
 //
-// The nonlinear complementarity problem (eq. 27)
+// The nonlinear complementarity problem (Broms eq. 27)
 //     0 <= lambda  _|_  d(lambda) - d_hat >= 0,   d(lambda) = d^P(Q(lambda)),
 // is linearised about the current iterate lambda_k, where the distances d_k = d(lambda_k) are
 // exact. With Q(lambda) = Q_t + dt Psi (U + M D lambda), to first order in dt,
@@ -13,7 +13,7 @@
 //     0 <= lambda  _|_  A lambda + b_k >= 0,   b_k = d_k - d_hat - A lambda_k,
 // warm-started at lambda_k (A lambda_k = dt D^T (M D lambda_k) is free: Q(lambda_k) needed
 // M D lambda_k). Then lambda_{k+1} is re-measured at Q(lambda_{k+1}) and the loop repeats until
-// every flagged pair has d >= d_hat (1 - separation_margin). A fixed point solves eq. 27
+// every flagged pair has d >= d_hat (1 - separation_margin). A fixed point solves Broms eq. 27
 // exactly, whatever the Jacobian approximation, since b_k uses the true distances. For spheres
 // without torques one LCP suffices: a centre distance is convex in the displacements, so the
 // linear model never overestimates d.
@@ -41,7 +41,7 @@ struct LcpSequenceOptions {
   // By default the sequence stops at its first separated iterate, which for spheres is the
   // first LCP, whose linear model underestimates the distances: pushed pairs may end above
   // d_hat (forces a few per cent too large in dense packings). With tol > 0 it goes on until
-  // an LCP changes lambda by less than tol ||lambda||_inf (eq. 29), aiming at d_hat (1 +
+  // an LCP changes lambda by less than tol ||lambda||_inf (Broms eq. 29), aiming at d_hat (1 +
   // margin) and then requiring d >= d_hat itself.
   double tol = 0.0;
   double margin = 0.0;
