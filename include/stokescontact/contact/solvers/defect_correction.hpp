@@ -28,7 +28,7 @@
 //  - A~ is lifted to positive definite where probing errors leave it indefinite;
 //  - where probes are shared and two corrections in a row fail to halve the shortfall (large
 //    dense clusters, whose many far fields add up), the round is finished by the LCP sequence
-//    with exact products, polished to complementarity (solver_lcp_sequence.hpp).
+//    with exact products, polished to complementarity (lcp_sequence.hpp).
 //
 // Stopping rule (Broms eq. 29 form): at an iterate whose flagged pairs all have d >= d_hat, stop when
 // the next correction would change lambda by less than tol ||lambda||_inf; that iterate is

@@ -9,7 +9,7 @@
 // greedily so that members of one colour are >= radius apart; row k of a probe is attributed
 // to the member nearest k when that member lies within radius / 2 (at most one can), and is
 // taken as 0 otherwise. The entries lost are the far field between contacts >= radius / 2
-// apart; the contact solver (solver_default.hpp) corrects for them with exact velocities.
+// apart; the contact solver (defect_correction.hpp) corrects for them with exact velocities.
 // With radius = infinity every probe has one member and A is exact (formed mode).
 //
 // Contacts sit at the midpoint of their closest points at Q*; distances between contacts use
