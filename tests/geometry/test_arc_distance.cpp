@@ -187,6 +187,70 @@ TEST(ArcDistance, ArcsCrossing) {
   expect_distance(kQuarter, moved(tilted, 0.1 * p), 0.1);  // pushed out along p
 }
 
+// Where curves cross at a small angle theta, f falls to 0 at a slope of only ~ R theta,
+// the shallowest valleys there are; the distance must still come out 0 to rounding. Issue
+// 16's case: arc a and the same arc turned by theta about a line in its plane through its
+// centre share the point where the line meets them. Before: up to 1.9e-9 (theta = 1e-8).
+TEST(ArcDistance, ArcsCrossingAtSmallAnglesMeetExactly) {
+  const Arc a{Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 0.5, 0.5 * kPi};
+  const Vec3 line(std::cos(kPi / 8), std::sin(kPi / 8), 0.0);
+  for (double theta = 1e-12; theta <= 1.5e-3; theta *= 10.0) {
+    const Eigen::AngleAxisd turn(theta, line);
+    Arc b = a;
+    b.e1 = turn * a.e1, b.e2 = turn * a.e2;
+    for (const double k : {1e-6, 1.0, 1e6}) {
+      SCOPED_TRACE(testing::Message() << "theta " << theta << " scale " << k);
+      const Arc ak = scaled(a, k), bk = scaled(b, k);
+      EXPECT_LE(sc::closest_points(ak, bk).distance, 4 * kEps * k);
+      EXPECT_LE(sc::closest_points(bk, ak).distance, 4 * kEps * k);
+    }
+  }
+}
+
+// The same with the turning line through an arc point P in the arc's plane at an angle to
+// the radius, so that b crosses a at P (and where the line leaves the circle), and b's
+// centre moves off a's: the valleys at those crossings are as shallow.
+TEST(ArcDistance, TurnedCopiesMeetExactly) {
+  const Arc a{Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 0.5, 0.5 * kPi};
+  for (const double t : {0.3, 0.92, 1.4}) {
+    for (const double phi : {0.4, 1.2, 2.2, 4.0}) {
+      for (double theta = 1e-12; theta <= 1.5e-3; theta *= 10.0) {
+        SCOPED_TRACE(testing::Message() << "t " << t << " phi " << phi << " theta " << theta);
+        const Vec3 p = a.point(t);
+        const Vec3 line = std::cos(phi) * p.normalized() + std::sin(phi) * a.tangent(t);
+        const Eigen::AngleAxisd turn(theta, line);
+        const Arc b{p - turn * p, turn * a.e1, turn * a.e2, a.radius, a.angle};
+        EXPECT_LE(sc::closest_points(a, b).distance, 4 * kEps);
+        EXPECT_LE(sc::closest_points(b, a).distance, 4 * kEps);
+      }
+    }
+  }
+}
+
+// A segment through an arc point P at a small angle alpha to the tangent there, tilted in
+// the arc's plane (it crosses the circle again at ~ 2 alpha) or out of it. Before: up to
+// 3e-11 short of 0.
+TEST(ArcDistance, SegmentNearlyTangentThroughAnArcPointMeetsIt) {
+  const Arc a{Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 0.5, 0.5 * kPi};
+  for (const double t : {0.1, kPi / 8, 1.0, 1.5}) {
+    const Vec3 p = a.point(t), tangent = a.tangent(t), radial = p.normalized();
+    const Vec3 tilts[] = {radial, -radial, Vec3::UnitZ(), (radial + Vec3::UnitZ()).normalized()};
+    for (const Vec3& tilt : tilts) {
+      for (const double alpha : {0.0, 1e-12, 1e-10, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2}) {
+        const Vec3 d = (std::cos(alpha) * tangent + std::sin(alpha) * tilt).normalized();
+        for (const double k : {1e-6, 1.0, 1e6}) {
+          SCOPED_TRACE(testing::Message() << "t " << t << " tilt " << tilt.transpose() << " alpha "
+                                          << alpha << " scale " << k);
+          const Segment s = scaled(Segment{p - 0.3 * d, p + 0.45 * d}, k);
+          const Arc ak = scaled(a, k);
+          EXPECT_LE(sc::closest_points(s, ak).distance, 4 * kEps * k);
+          EXPECT_LE(sc::closest_points(ak, s).distance, 4 * kEps * k);
+        }
+      }
+    }
+  }
+}
+
 // Two linked unit rings, each through the other's centre: every point of one is exactly
 // 1 from the other (a degenerate, constant f the search must still settle).
 TEST(ArcDistance, LinkedRings) {

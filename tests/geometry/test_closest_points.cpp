@@ -263,6 +263,37 @@ TEST(ClosestPoints, RodsAtKnownDistances) {
       0.5, 1e-15);
 }
 
+// Parallel rods of any orientation and place touch along a line: the closest points are the
+// middle of the overlap of their axes (segment_distance.hpp), with the normal across the
+// axes, so the contact force of a symmetric pair sits at both rods' centres.
+TEST(ClosestPoints, ParallelRodsMeetAtTheMiddleOfTheirOverlap) {
+  Rng rng(41);
+  for (int i = 0; i < 2000; ++i) {
+    const sc::Spherocylinder a{uniform(rng, 1.0, 4.0), 0.5}, b{uniform(rng, 1.0, 4.0), 0.3};
+    const Pose pa = random_pose(rng, 1000.0);
+    const Vec3 axis = pa.q * Vec3::UnitZ();
+    const Vec3 across = axis.cross(brute_force::random_unit_vector(rng)).normalized();
+    const double shift = uniform(rng, -0.5, 0.5) * (a.length + b.length);  // along the axis
+    const Pose pb{pa.x + uniform(rng, 0.7, 2.0) * across + shift * axis, pa.q};
+    const double lo = std::max(-0.5 * a.length, shift - 0.5 * b.length);
+    const double hi = std::min(0.5 * a.length, shift + 0.5 * b.length);
+    ASSERT_LE(lo, hi);
+    const sc::ClosestPoints cp = sc::closest_points(a, pa, b, pb);
+    const double rounding = 16 * std::numeric_limits<double>::epsilon() * (pa.x.norm() + 4.0);
+    EXPECT_NEAR((cp.curve_point_a - pa.x).dot(axis), 0.5 * (lo + hi), rounding) << "pair " << i;
+    EXPECT_NEAR((cp.curve_point_b - pa.x).dot(axis), 0.5 * (lo + hi), rounding) << "pair " << i;
+    EXPECT_NEAR(cp.normal.dot(axis), 0.0, rounding) << "pair " << i;
+  }
+  // A symmetric pair along x: the points lie exactly above each other at the rods' centres.
+  const sc::Spherocylinder rod{4.0, 0.5};
+  const sc::Quat to_x(Eigen::AngleAxisd(0.5 * kPi, Vec3::UnitY()));
+  const sc::ClosestPoints cp =
+      sc::closest_points(rod, Pose{Vec3(3, -2, 1), to_x}, rod, Pose{Vec3(3, -0.99, 1), to_x});
+  EXPECT_NEAR(cp.curve_point_a.x(), 3.0, 1e-15);
+  EXPECT_NEAR(cp.curve_point_b.x(), 3.0, 1e-15);
+  EXPECT_NEAR((cp.normal - Vec3::UnitY()).norm(), 0.0, 1e-15);
+}
+
 // Curves that meet have no joining direction: the documented fallbacks apply, and the
 // witnesses still satisfy point_b - point_a = distance * normal with a unit normal.
 TEST(ClosestPoints, FallbackNormalWhereCurvesMeet) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -60,6 +61,99 @@ TEST(SegmentDistance, Parallel) {
 
 TEST(SegmentDistance, Antiparallel) {
   expect_case({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {Vec3(2, 1, 0), Vec3(0.3, 1, 0)}, 1.0);
+}
+
+// Parallel segments are closest along the whole overlap of their projections: the points
+// returned are its midpoint, so a symmetric pair of rods gets a force at its middle.
+// Overlaps of every kind (partial, b inside a, a inside b, touching at one point,
+// antiparallel), offsets across the axis in and out of plane, every scale, both orders.
+TEST(SegmentDistance, ParallelOverlapReturnsItsMidpoint) {
+  const Segment a{Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  const double spans[][2] = {{0.3, 2.0}, {-1.0, 0.4}, {0.2, 0.7}, {-1.0, 3.0},
+                             {1.0, 2.0}, {2.0, 0.3},  {0.7, 0.2}, {0.0, 1.0}};
+  const Vec3 offsets[] = {Vec3(0, 1, 0), Vec3(0, 0.3, -0.4), Vec3(0, 1e-3, 0), Vec3(0, 0, 0)};
+  for (const auto& span : spans) {
+    for (const Vec3& offset : offsets) {
+      const Segment b0{Vec3(span[0], 0, 0) + offset, Vec3(span[1], 0, 0) + offset};
+      const double lo = std::max(0.0, std::min(span[0], span[1]));
+      const double hi = std::min(1.0, std::max(span[0], span[1]));
+      const double middle = 0.5 * (lo + hi);
+      for (const double k : kScales) {
+        SCOPED_TRACE(testing::Message() << "b from " << span[0] << " to " << span[1] << " offset "
+                                        << offset.transpose() << " scale " << k);
+        const Segment sa = scaled(a, k), sb = scaled(b0, k);
+        for (const bool swap : {false, true}) {
+          const sc::PieceClosestPoints c =
+              swap ? sc::swapped(sc::closest_points(sb, sa)) : sc::closest_points(sa, sb);
+          EXPECT_NEAR(c.distance, k * offset.norm(), 4 * kEps * k);
+          EXPECT_LE((c.point_a - k * Vec3(middle, 0, 0)).norm(), 4 * kEps * k);
+          EXPECT_LE((c.point_b - k * (Vec3(middle, 0, 0) + offset)).norm(), 4 * kEps * k);
+          expect_consistent(sa, sb, c, k);
+        }
+      }
+    }
+  }
+}
+
+// The same for copies turned and moved at random, as rods' centre segments come out of
+// their poses: parallel only to rounding, and still met at the midpoint to rounding.
+TEST(SegmentDistance, RoundedParallelOverlapReturnsItsMidpoint) {
+  brute_force::Rng rng(16);
+  for (int i = 0; i < 2000; ++i) {
+    const double k = std::pow(10.0, brute_force::uniform(rng, -6.0, 6.0));
+    const Vec3 axis = brute_force::random_unit_vector(rng);
+    const Vec3 across = axis.cross(brute_force::random_unit_vector(rng)).normalized();
+    const Vec3 origin = k * 100.0 * brute_force::random_unit_vector(rng);
+    const double la = brute_force::uniform(rng, 0.5, 4.0), lb = brute_force::uniform(rng, 0.5, 4.0);
+    const double shift = brute_force::uniform(rng, -4.0, 4.0);
+    const double gap = brute_force::uniform(rng, 0.0, 2.0);
+    const Vec3 b_origin = origin + k * (gap * across + shift * axis);
+    const Segment a{origin, origin + k * la * axis};
+    const Segment b{b_origin, b_origin + k * lb * axis};
+    const double lo = std::max(0.0, shift), hi = std::min(la, shift + lb);
+    if (hi < lo) continue;  // end to end: the nearest ends, tested elsewhere
+    const sc::PieceClosestPoints c = sc::closest_points(a, b);
+    const double middle = 0.5 * (lo + hi);
+    const double rounding = 64 * kEps * (origin.norm() + 8 * k);
+    EXPECT_LE((c.point_a - (origin + k * middle * axis)).norm(), rounding) << "pair " << i;
+    EXPECT_LE((c.point_b - (b_origin + k * (middle - shift) * axis)).norm(), rounding)
+        << "pair " << i;
+    EXPECT_NEAR(c.distance, k * gap, rounding) << "pair " << i;
+  }
+}
+
+// Nearly parallel, tilted in the plane of the offset so that the exact closest points sit
+// at one end of the overlap or the other with the sign of the tilt theta. Within the
+// rounding of the coordinates (theta ~ 1e-15 here) the points move to the midpoint of the
+// overlap and back, continuously in theta; beyond it they are the exact minimisers. The
+// distance stays within rounding of the exact minimum throughout. (The offset h is small
+// enough for h + theta to resolve theta's steps: ulp(h) = rounding / 380.)
+TEST(SegmentDistance, NearlyParallelMovesContinuouslyToTheMidpoint) {
+  const double h = 1.0 / 64.0;
+  const double rounding = sc::detail::kLineContactRounding * 1.0;  // the largest coordinate is 1
+  const Segment a{Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  const auto tilted = [&](double theta) { return Segment{Vec3(0, h, 0), Vec3(1, h + theta, 0)}; };
+  double previous = -1.0;
+  for (int i = -200; i <= 200; ++i) {
+    const double theta = 3.0 * rounding * i / 200.0;
+    SCOPED_TRACE(testing::Message() << "theta " << theta);
+    const sc::PieceClosestPoints c = sc::closest_points(a, tilted(theta));
+    const double exact = theta < 0.0 ? h + theta : h;  // at s = 1 or s = 0
+    EXPECT_GE(c.distance, exact - 4 * kEps);
+    EXPECT_LE(c.distance, exact + rounding);
+    if (std::abs(theta) <= rounding) {
+      EXPECT_NEAR(c.parameter_a, 0.5, 1e-12);
+    } else if (theta >= 2.05 * rounding) {  // 2 rounding, and V's own rounding
+      EXPECT_EQ(c.parameter_a, 0.0);
+    } else if (theta <= -2.05 * rounding) {
+      EXPECT_EQ(c.parameter_a, 1.0);
+    }
+    // Steps of 3 rounding / 200 in theta move the points by at most ~ 1/100 of the overlap.
+    if (previous >= 0.0) {
+      EXPECT_LE(std::abs(c.parameter_a - previous), 0.02);
+    }
+    previous = c.parameter_a;
+  }
 }
 
 TEST(SegmentDistance, ParallelWithoutOverlapMeetsAtEnds) {

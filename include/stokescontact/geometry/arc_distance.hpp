@@ -7,7 +7,12 @@
 // f over t by best-first branch and bound with rigorous lower bounds on each interval,
 // polish each bracketed local minimum (f' from - to +) with a root-finder on the slope,
 // and stop when no interval's lower bound can beat the best distance by more than
-// tau = 1e-12 (R + distance). Bounds on an interval of width w (several, the largest wins):
+// tau = 4 eps (|c|_inf + R + distance), a few units of the coordinates' rounding. Where the
+// curves cross or touch at a small angle theta, f's valley has slope ~ R theta; the slope
+// is taken along the velocity of C relative to the target's closest point (reach), whose
+// rounding shrinks with theta, and the bounds allow for the rounding of n, so such
+// crossings are found and polished to rounding too. Bounds on an interval of width w
+// (several, the largest wins):
 //  - Lipschitz: |C'| = R and f is 1-Lipschitz in the point: f >= (f(l) + f(r) - R w) / 2.
 //  - Convexity: for a convex target (a segment, a point) the plane through the closest
 //    point normal to n separates it from C(a), giving a concave quadratic below f from
@@ -44,33 +49,59 @@ struct ArcMotion {
   Vec3 velocity;
 };
 
+// A bound on |C(t)|_inf over the whole circle.
+inline double coordinate_bound(const Arc& a) { return a.centre.cwiseAbs().maxCoeff() + a.radius; }
+
 inline ArcMotion arc_motion(const Arc& a, double t) {
   const double c = std::cos(t), s = std::sin(t);
   const Vec3 radial = a.radius * (c * a.e1 + s * a.e2);
   return {a.centre + radial, radial, a.radius * (c * a.e2 - s * a.e1)};
 }
 
-// Distance |x - y| from the arc point x to a point y of a target, its t-slope, and the
-// bend that bounds how fast it can fall below its tangent line (see convex_bound).
+// Distance |x - y| from the arc point x to its closest point y on a target, its t-slope,
+// the bend that bounds how fast it can fall below its tangent line (see convex_bound), the
+// speed |w| of the relative velocity w the slope is taken along, and the rounding of the
+// unit vector n = (x - y) / |x - y|: x - y carries ~ eps (|x| + |y|) of rounding, and
+// `coordinates` bounds |x|_inf + |y|_inf (a constant of the search).
+//
+// The slope is n . C'. Where y lies inside a smooth piece of the target, n is normal to the
+// target's tangent there, so n . C' = n . w for w = C' less its component along that
+// tangent: w is the velocity of x relative to y, which slides along the target. Computed
+// from C' the slope's rounding is |C'| times n's; from w it is |w| times n's, and |w|
+// vanishes where the curves cross or touch at a small angle, exactly where f's valley is
+// shallow: there, n . C' is pure rounding within |x - y| ~ eps |x| R / |w| of a crossing,
+// and the polish would stop that far from it. Where y is an end point (it does not move),
+// w = C'.
 struct Reach {
   double distance;
   double slope;
   double bend;
+  double speed;
+  double rounding;  // |error of n|, so slope and bend are exact to rounding * |w|, * R
 };
 
-inline Reach reach(const Vec3& offset, const ArcMotion& m) {
+// C' relative to a closest point sliding along the unit tangent `along`.
+inline Vec3 sliding(const ArcMotion& m, const Vec3& along) {
+  return m.velocity - m.velocity.dot(along) * along;
+}
+
+inline Reach reach(const ArcMotion& m, const Vec3& y, const Vec3& w, double coordinates) {
+  const Vec3 offset = m.point - y;
   const double d = offset.norm();
-  if (!(d > 0.0)) return {0.0, 0.0, 0.0};
+  if (!(d > 0.0)) return {0.0, 0.0, 0.0, w.norm(), 0.0};  // f >= 0 = f(t): any slope <= 0 holds
   const double inv = 1.0 / d;
-  return {d, offset.dot(m.velocity) * inv, std::max(offset.dot(m.radial) * inv, 0.0)};
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  return {d, offset.dot(w) * inv, std::max(offset.dot(m.radial) * inv, 0.0), w.norm(),
+          8.0 * eps * coordinates * inv};
 }
 
 // One evaluation along the searched arc.
 struct ArcSample {
   double t;
-  double f;   // distance from C(t) to the target
-  double df;  // df/dt (either one-sided value at a kink)
-  double u;   // target parameter of the closest point
+  double f;      // distance from C(t) to the target
+  double df;     // df/dt (either one-sided value at a kink)
+  double speed;  // |w|, the relative speed df is taken along (see reach)
+  double u;      // target parameter of the closest point
   Vec3 point;
   Vec3 target_point;
 };
@@ -104,20 +135,34 @@ inline double semiconvex_bound(double gl, double dl, double gr, double dr, doubl
 // Each end's own modulus also gives a bound alone (its parabola is lowest at an end of
 // the interval); at a polished minimum (slope 0) facing a target outside the bend that
 // alone certifies the whole interval, however steep f is at the other end.
+// The computed n is off by up to `rounding`, which matters where f is small: the slope is
+// taken at its least favourable within rounding * |w| (lowest going right, highest going
+// left) and n . radial at its largest within rounding * R. (Without this, near-coincident
+// arcs whose n . radial is below its rounding had an interval holding their crossing
+// bounded away from 0 and dropped.)
+inline double slope_rounding(const Reach& e) { return e.rounding * e.speed; }
+
 inline double modulus(const Reach& e, double w, double radius) {
-  return std::min(e.bend + std::abs(e.slope) * w / 3.0, radius);
+  const double bend = e.bend + e.rounding * radius;
+  return std::min(bend + (std::abs(e.slope) + slope_rounding(e)) * w / 3.0, radius);
 }
 
 inline double one_end_bound(const Reach& e, double signed_w, double radius) {
   const double w = std::abs(signed_w);
-  return std::min(e.distance,
-                  e.distance + e.slope * signed_w - 0.5 * modulus(e, w, radius) * w * w);
+  return std::min(e.distance, e.distance + e.slope * signed_w - slope_rounding(e) * w -
+                                  0.5 * modulus(e, w, radius) * w * w);
+}
+
+// The semiconvex bound from both ends, slopes taken at their least favourable.
+inline double semiconvex_bound(const Reach& l, const Reach& r, double w, double m) {
+  return semiconvex_bound(l.distance, l.slope - slope_rounding(l), r.distance,
+                          r.slope + slope_rounding(r), w, m);
 }
 
 inline double convex_bound(const Reach& l, const Reach& r, double w, double radius) {
   const double m = std::max(modulus(l, w, radius), modulus(r, w, radius));
-  return std::max({semiconvex_bound(l.distance, l.slope, r.distance, r.slope, w, m),
-                   one_end_bound(l, w, radius), one_end_bound(r, -w, radius)});
+  return std::max({semiconvex_bound(l, r, w, m), one_end_bound(l, w, radius),
+                   one_end_bound(r, -w, radius)});
 }
 
 // Along C(t), the squared distance to a fixed point o and the height of C(t) - o along a
@@ -181,7 +226,7 @@ inline Range squared(const Range& r) {
 class SegmentTarget {
  public:
   struct Sample : ArcSample {
-    double bend;
+    double bend, rounding;  // see reach
     Probe probe;
   };
 
@@ -190,7 +235,10 @@ class SegmentTarget {
         direction_(s.p1 - s.p0),
         length_(direction_.norm()),
         inv_length2_(1.0 / direction_.squaredNorm()),
-        probes_(along, s.p0, direction_ / length_),
+        unit_(direction_ / length_),
+        coordinates_(coordinate_bound(along) +
+                     std::max(s.p0.cwiseAbs().maxCoeff(), s.p1.cwiseAbs().maxCoeff())),
+        probes_(along, s.p0, unit_),
         along_(along) {}
 
   std::array<Sample, 0> seeds() const { return {}; }
@@ -198,12 +246,14 @@ class SegmentTarget {
   Sample sample(double t) const {
     const ArcMotion m = arc_motion(along_, t);
     const Vec3 offset = m.point - p0_;
-    const double s = std::clamp(offset.dot(direction_) * inv_length2_, 0.0, 1.0);
+    const double projection = offset.dot(direction_) * inv_length2_;
+    const double s = std::clamp(projection, 0.0, 1.0);
     const Vec3 q = p0_ + s * direction_;
-    const Reach r = reach(m.point - q, m);
+    const bool inside = s == projection && s > 0.0 && s < 1.0;  // else q is an end
+    const Reach r = reach(m, q, inside ? sliding(m, unit_) : m.velocity, coordinates_);
     Sample out;
-    static_cast<ArcSample&>(out) = {t, r.distance, r.slope, s, m.point, q};
-    out.bend = r.bend;
+    static_cast<ArcSample&>(out) = {t, r.distance, r.slope, r.speed, s, m.point, q};
+    out.bend = r.bend, out.rounding = r.rounding;
     out.probe = probes_.probe(offset, m);
     return out;
   }
@@ -214,13 +264,16 @@ class SegmentTarget {
     const double line2 = probes_.squares(l.probe, r.probe).lo - squared(heights).hi;
     const double overshoot = std::max({heights.lo - length_, -heights.hi, 0.0});
     return std::max({0.0, lipschitz_bound(l.f, r.f, w, radius),
-                     convex_bound({l.f, l.df, l.bend}, {r.f, r.df, r.bend}, w, radius),
+                     convex_bound({l.f, l.df, l.bend, l.speed, l.rounding},
+                                  {r.f, r.df, r.bend, r.speed, r.rounding}, w, radius),
                      std::sqrt(std::max(line2, 0.0) + overshoot * overshoot)});
   }
 
  private:
   Vec3 p0_, direction_;  // p0 + s direction, s in [0, 1]
   double length_, inv_length2_;
+  Vec3 unit_;           // direction / length
+  double coordinates_;  // bounds |arc point|_inf + |segment point|_inf
   ProbeShape probes_;
   Arc along_;
 };
@@ -239,6 +292,7 @@ class ArcTarget {
   ArcTarget(const Arc& target, const Arc& along)
       : arc_(target),
         ends_{target.point(0.0), target.point(target.angle)},
+        coordinates_(coordinate_bound(along) + coordinate_bound(target)),
         probes_(along, target.centre, target.axis()),
         along_(along) {}
 
@@ -248,8 +302,8 @@ class ArcTarget {
     std::array<Sample, 2> out{};
     for (int k = 0; k < 2; ++k) {
       const CurvePoint c = closest_point(along_, ends_[k]);
-      static_cast<ArcSample&>(out[k]) = {c.parameter, c.distance, 0.0, k == 0 ? 0.0 : arc_.angle,
-                                         c.point,     ends_[k]};
+      static_cast<ArcSample&>(out[k]) = {c.parameter, c.distance, 0.0, along_.radius,
+                                         k == 0 ? 0.0 : arc_.angle, c.point, ends_[k]};
     }
     return out;
   }
@@ -265,22 +319,26 @@ class ArcTarget {
     s.rho = std::sqrt(px * px + py * py);
     s.gap = 0.0;
     if (s.rho > 0.0) {
-      const Vec3 radial = (px * arc_.e1 + py * arc_.e2) / s.rho;
-      s.circle = reach(x - arc_.radius * radial, m);
+      const double inv_rho = 1.0 / s.rho;
+      const Vec3 radial = inv_rho * (px * arc_.e1 + py * arc_.e2);
+      const Vec3 tangent = inv_rho * (px * arc_.e2 - py * arc_.e1);  // the circle's, at y
+      const Vec3 y = arc_.centre + arc_.radius * radial;
+      s.circle = reach(m, y, sliding(m, tangent), coordinates_);
       double phi = std::atan2(py, px);
       if (phi < 0.0) phi += 2.0 * std::numbers::pi;
       if (phi > arc_.angle) s.gap = std::min(phi - arc_.angle, 2.0 * std::numbers::pi - phi);
       if (s.gap == 0.0) {
-        s.f = s.circle.distance, s.df = s.circle.slope, s.u = phi;
-        s.target_point = arc_.centre + arc_.radius * radial;
+        s.f = s.circle.distance, s.df = s.circle.slope, s.speed = s.circle.speed, s.u = phi;
+        s.target_point = y;
         return s;
       }
     }
-    const Reach e0 = reach(m.point - ends_[0], m), e1 = reach(m.point - ends_[1], m);
+    const Reach e0 = reach(m, ends_[0], m.velocity, coordinates_);
+    const Reach e1 = reach(m, ends_[1], m.velocity, coordinates_);
     const bool second = e1.distance < e0.distance;  // the nearer end
     const Reach& e = second ? e1 : e0;
-    if (!(s.rho > 0.0)) s.circle = {e.distance, e.slope, 0.0};  // on the axis
-    s.f = e.distance, s.df = e.slope;
+    if (!(s.rho > 0.0)) s.circle = {e.distance, e.slope, 0.0, e.speed, e.rounding};  // on the axis
+    s.f = e.distance, s.df = e.slope, s.speed = e.speed;
     s.u = second ? arc_.angle : 0.0;
     s.target_point = ends_[second ? 1 : 0];
     return s;
@@ -301,10 +359,10 @@ class ArcTarget {
     const double off_circle = std::max({rho_lo - arc_.radius, arc_.radius - rho_hi, 0.0});
     double circle = std::max(lipschitz_bound(l.circle.distance, r.circle.distance, w, radius),
                              std::sqrt(off_circle * off_circle + z2.lo));
-    if (rho_min > 0.0)
-      circle =
-          std::max(circle, semiconvex_bound(l.circle.distance, l.circle.slope, r.circle.distance,
-                                            r.circle.slope, w, radius + radius * radius / rho_min));
+    if (rho_min > 0.0) {
+      const double m = radius + radius * radius / rho_min;
+      circle = std::max(circle, semiconvex_bound(l.circle, r.circle, w, m));
+    }
     // From a sample outside the circle's cylinder (rho >= radius) the whole circle lies
     // behind the plane through its closest point normal to n: a convex target's bound.
     if (l.rho >= arc_.radius) circle = std::max(circle, one_end_bound(l.circle, w, radius));
@@ -315,17 +373,18 @@ class ArcTarget {
  private:
   Arc arc_;
   std::array<Vec3, 2> ends_;
+  double coordinates_;  // bounds |arc point|_inf + |target point|_inf
   ProbeShape probes_;
   Arc along_;
 };
 
 // Search tuning: initial grid spacing (a quarter arc starts with 2 intervals), the
-// tolerance tau relative to the arc radius plus the best distance, and the budgets. The
-// budget binds only where f stays within tau of its minimum along a stretch in a way no
-// bound above sees (two linked rings, each through the other's centre, are 1 apart at
-// every point): the best sample is then as good as any.
+// tolerance tau relative to the searched arc's coordinates (|c|_inf + R) plus the best
+// distance, and the budgets. The budget binds only where f stays within tau of its
+// minimum along a stretch in a way no bound above sees (two linked rings, each through
+// the other's centre, are 1 apart at every point): the best sample is then as good as any.
 inline constexpr double kArcGridStep = std::numbers::pi / 4.0;
-inline constexpr double kArcTolerance = 1e-12;
+inline constexpr double kArcTolerance = 4 * std::numeric_limits<double>::epsilon();
 inline constexpr int kArcMaxSamples = 160;
 inline constexpr int kArcMaxEvaluations = 400;
 inline constexpr int kArcMaxPolishSteps = 60;
@@ -367,10 +426,12 @@ PieceClosestPoints minimise_along_arc(const Arc& arc, const Target& target, doub
   };
 
   // Local minimum inside a bracket f'(l) < 0 < f'(r): the Illinois variant of regula
-  // falsi on g' = f f' = (C - y) . C', the slope of f^2 / 2, which stays smooth through a
-  // crossing (f = 0) where f' jumps. It converges superlinearly and keeps the bracket; its
-  // sign can only turn from - to + at a local minimum (f's kinks at the medial axis of an
-  // arc target are concave).
+  // falsi on g' = f f' = (C - y) . w, the slope of f^2 / 2 (w: C' relative to y, see
+  // reach), which stays smooth through a crossing (f = 0) where f' jumps. It converges
+  // superlinearly and keeps the bracket; its sign can only turn from - to + at a local
+  // minimum (f's kinks at the medial axis of an arc target are concave). g' is computed
+  // to eps (|w| |C| + f |C'|): at a crossing at a small angle, g' ~ f |w|, so the search
+  // stops only where f is down to a few eps |C|, however small the angle.
   const auto polish = [&](const Sample& l, const Sample& r) {
     constexpr double eps = std::numeric_limits<double>::epsilon();
     Sample lo = l, hi = r;
@@ -384,8 +445,10 @@ PieceClosestPoints minimise_along_arc(const Arc& arc, const Target& target, doub
       const Sample s = evaluate(x);
       const double g = s.f * s.df;
       // Within its own rounding, g' has found its root.
-      const double noise = 8.0 * eps * arc.radius *
-                           (s.point.cwiseAbs().maxCoeff() + s.target_point.cwiseAbs().maxCoeff());
+      const double noise =
+          8.0 * eps *
+          (s.speed * (s.point.cwiseAbs().maxCoeff() + s.target_point.cwiseAbs().maxCoeff()) +
+           s.f * arc.radius);
       if (std::abs(g) <= noise) return s;
       if (g > 0.0) {
         hi = s, gb = g;
@@ -405,7 +468,7 @@ PieceClosestPoints minimise_along_arc(const Arc& arc, const Target& target, doub
   const int n = std::clamp(static_cast<int>(std::ceil(arc.angle / kArcGridStep)), 1, 32);
   for (int i = 0; i <= n; ++i) add(evaluate(i == n ? arc.angle : arc.angle * i / n), false);
   for (const Sample& s : target.seeds()) add(s, true);  // candidates only, never interval ends
-  tau = kArcTolerance * (arc.radius + best_f);
+  tau = kArcTolerance * (arc.centre.cwiseAbs().maxCoeff() + arc.radius + best_f);
   for (int i = 0; i < n; ++i) push(i, i + 1);
 
   while (heap_size > 0 && count + 1 < kArcMaxSamples && evaluations < kArcMaxEvaluations) {
