@@ -24,7 +24,7 @@
 //    before the distances are measured (their rows come free with the probes);
 //  - from the second correction on, each measured step (delta lambda, delta d) corrects A~ by
 //    a multisecant update (secant_update.hpp); the memory is dropped when a correction makes
-//    the worst shortfall grow (line contacts of parallel rods, whose closest points jump);
+//    the worst shortfall grow (line contacts of near-parallel rods);
 //  - A~ is lifted to positive definite where probing errors leave it indefinite;
 //  - where probes are shared and two corrections in a row fail to halve the shortfall (large
 //    dense clusters, whose many far fields add up), the round is finished by the LCP sequence
