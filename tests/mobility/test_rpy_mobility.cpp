@@ -105,16 +105,6 @@ TEST(RpyPairBlocks, FarRotationBlocksAreHalfCurlOfTheFlow) {
   }
 }
 
-TEST(RpyKernel, InverseSqrtIsAccurateToAFewUlp) {
-  double worst = 0.0;
-  for (double e = -300.0; e <= 300.0; e += 0.37) {
-    const double x = std::pow(10.0, e);
-    const double exact = 1.0 / std::sqrt(x);
-    worst = std::max(worst, std::abs(sc::detail::inverse_sqrt(x) - exact) / exact);
-  }
-  EXPECT_LT(worst, 4.0 * std::numeric_limits<double>::epsilon());
-}
-
 TEST(RpyMobility, SingleSphereIsStokesEinstein) {
   const double a = 0.9, eta = 1.4;
   sc::RpyMobility m(1, {eta, a}, 6);

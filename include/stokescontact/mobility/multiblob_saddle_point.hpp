@@ -19,6 +19,9 @@
 
 namespace stokescontact {
 
+// Below this many blobs the per-body preconditioner solves are too short to share out.
+inline constexpr Eigen::Index kPreconditionerParallelMinBlobs = 1024;
+
 struct MultiblobSaddlePoint {
   Mat3X blobs;                                  // world blob centres / a
   Mat3X offsets;                                // world blob centre - body centre, / a
@@ -52,7 +55,7 @@ struct MultiblobSaddlePoint {
     VecX z(size());
     const auto bodies_n = body_count();
 #ifdef _OPENMP
-#pragma omp parallel for schedule(static) if (blob_count() >= 4 * kRpyParallelMinBlobs)
+#pragma omp parallel for schedule(static) if (blob_count() >= kPreconditionerParallelMinBlobs)
 #endif
     for (Eigen::Index i = 0; i < bodies_n; ++i) {
       const auto [begin, n] = range(i);
