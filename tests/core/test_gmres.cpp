@@ -5,27 +5,19 @@
 #include <random>
 #include <stdexcept>
 
+#include "common/test_support.hpp"
 #include "stokescontact/core/gmres.hpp"
 
 namespace sc = stokescontact;
 
 namespace {
 
-sc::MatX random_matrix(Eigen::Index n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g(0.0, 1.0);
-  sc::MatX a(n, n);
-  for (Eigen::Index j = 0; j < n; ++j)
-    for (Eigen::Index i = 0; i < n; ++i) a(i, j) = g(rng);
-  return a;
-}
-
-sc::VecX random_vector(Eigen::Index n, unsigned seed) { return random_matrix(n, seed).col(0); }
+sc::VecX random_vector(Eigen::Index n, unsigned seed) { return test_support::random_matrix(n, seed).col(0); }
 
 // A with prescribed singular values: U diag(s) V^T from two random orthogonal factors.
 sc::MatX with_singular_values(const sc::VecX& s, unsigned seed) {
   const Eigen::Index n = s.size();
-  const Eigen::HouseholderQR<sc::MatX> qu(random_matrix(n, seed)), qv(random_matrix(n, seed + 1));
+  const Eigen::HouseholderQR<sc::MatX> qu(test_support::random_matrix(n, seed)), qv(test_support::random_matrix(n, seed + 1));
   const sc::MatX u = qu.householderQ(), v = qv.householderQ();
   return u * s.asDiagonal() * v.transpose();
 }
@@ -38,7 +30,7 @@ double relative_residual(const sc::MatX& a, const sc::VecX& x, const sc::VecX& b
 
 TEST(Gmres, SolvesSpdSystemLikeDenseCholesky) {
   const Eigen::Index n = 60;
-  const sc::MatX r = random_matrix(n, 3);
+  const sc::MatX r = test_support::random_matrix(n, 3);
   const sc::MatX a = r * r.transpose() + n * sc::MatX::Identity(n, n);
   const sc::VecX b = random_vector(n, 4);
   const sc::VecX exact = a.llt().solve(b);
@@ -52,7 +44,7 @@ TEST(Gmres, SolvesSpdSystemLikeDenseCholesky) {
 
 TEST(Gmres, SolvesNonSymmetricSystemLikeDenseLu) {
   const Eigen::Index n = 80;
-  const sc::MatX a = 3.0 * std::sqrt(static_cast<double>(n)) * sc::MatX::Identity(n, n) + random_matrix(n, 5);
+  const sc::MatX a = 3.0 * std::sqrt(static_cast<double>(n)) * sc::MatX::Identity(n, n) + test_support::random_matrix(n, 5);
   const sc::VecX b = random_vector(n, 6);
   const sc::VecX exact = a.partialPivLu().solve(b);
   const auto result = sc::gmres([&](const sc::VecX& v) { return sc::VecX(a * v); }, b, {1e-11, 400, 20});
@@ -66,7 +58,7 @@ TEST(Gmres, RightPreconditionerCutsIterationsAndKeepsTrueResidual) {
   const Eigen::Index n = 100;
   sc::VecX d(n);
   for (Eigen::Index i = 0; i < n; ++i) d(i) = std::pow(10.0, 4.0 * static_cast<double>(i) / (n - 1));
-  const sc::MatX a = (sc::MatX::Identity(n, n) + 0.3 / std::sqrt(n) * random_matrix(n, 7)) * d.asDiagonal();
+  const sc::MatX a = (sc::MatX::Identity(n, n) + 0.3 / std::sqrt(n) * test_support::random_matrix(n, 7)) * d.asDiagonal();
   const sc::VecX b = random_vector(n, 8);
   const sc::VecX exact = a.partialPivLu().solve(b);
   const sc::VecX inv_diag = a.diagonal().cwiseInverse();
@@ -103,7 +95,7 @@ TEST(Gmres, RestartingStillConvergesOnAnSpdSystem) {
   const Eigen::Index n = 120;
   sc::VecX s(n);
   for (Eigen::Index i = 0; i < n; ++i) s(i) = 1.0 + 99.0 * static_cast<double>(i) / (n - 1);
-  const Eigen::HouseholderQR<sc::MatX> q(random_matrix(n, 11));
+  const Eigen::HouseholderQR<sc::MatX> q(test_support::random_matrix(n, 11));
   const sc::MatX u = q.householderQ();
   const sc::MatX a = u * s.asDiagonal() * u.transpose();
   const sc::VecX b = random_vector(n, 12);
@@ -168,7 +160,7 @@ TEST(Gmres, IterationLimitIsHonoured) {
 
 TEST(Gmres, ExactInitialGuessAndZeroRightHandSide) {
   const Eigen::Index n = 10;
-  const sc::MatX a = sc::MatX::Identity(n, n) + 0.1 * random_matrix(n, 13);
+  const sc::MatX a = sc::MatX::Identity(n, n) + 0.1 * test_support::random_matrix(n, 13);
   const auto op = [&](const sc::VecX& v) { return sc::VecX(a * v); };
   const sc::VecX x = random_vector(n, 14);
   const sc::VecX b = a * x;

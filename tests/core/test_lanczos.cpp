@@ -14,22 +14,13 @@ namespace {
 
 using test_support::expect_rejects;
 
-sc::MatX random_matrix(Eigen::Index n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g(0.0, 1.0);
-  sc::MatX a(n, n);
-  for (Eigen::Index j = 0; j < n; ++j)
-    for (Eigen::Index i = 0; i < n; ++i) a(i, j) = g(rng);
-  return a;
-}
-
 // A = Q diag(lambda) Q^T and, independently of any eigensolver, A^(1/2) = Q diag(sqrt lambda) Q^T.
 struct KnownSpectrum {
   sc::MatX a, sqrt_a;
 };
 
 KnownSpectrum with_eigenvalues(const sc::VecX& lambda, unsigned seed) {
-  const Eigen::HouseholderQR<sc::MatX> qr(random_matrix(lambda.size(), seed));
+  const Eigen::HouseholderQR<sc::MatX> qr(test_support::random_matrix(lambda.size(), seed));
   const sc::MatX q = qr.householderQ();
   return {q * lambda.asDiagonal() * q.transpose(), q * lambda.cwiseSqrt().asDiagonal() * q.transpose()};
 }
@@ -60,7 +51,7 @@ struct CountingOperator {
 TEST(LanczosSqrt, MatchesSquareRootOfKnownSpectrumToTolerance) {
   const Eigen::Index n = 80;
   const KnownSpectrum m = with_eigenvalues(log_spaced(n, 100.0), 11);
-  const sc::VecX b = random_matrix(n, 12).col(0);
+  const sc::VecX b = test_support::random_matrix(n, 12).col(0);
   const sc::VecX exact = m.sqrt_a * b;
   for (const double tolerance : {1e-4, 1e-8, 1e-12}) {
     int applications = 0;
@@ -77,7 +68,7 @@ TEST(LanczosSqrt, MatchesSquareRootOfKnownSpectrumToTolerance) {
 TEST(LanczosSqrt, TighterToleranceTakesMoreSteps) {
   const Eigen::Index n = 60;
   const KnownSpectrum m = with_eigenvalues(log_spaced(n, 1e3), 13);
-  const sc::VecX b = random_matrix(n, 14).col(0);
+  const sc::VecX b = test_support::random_matrix(n, 14).col(0);
   const auto op = [&](const sc::VecX& v) { return sc::VecX(m.a * v); };
   const auto loose = sc::lanczos_sqrt(op, b, {1e-3, 200});
   const auto tight = sc::lanczos_sqrt(op, b, {1e-10, 200});
@@ -88,7 +79,7 @@ TEST(LanczosSqrt, TighterToleranceTakesMoreSteps) {
 TEST(LanczosSqrt, EigenvectorStartIsExactAfterOneStep) {
   const Eigen::Index n = 20;
   sc::VecX lambda = log_spaced(n, 50.0);
-  const Eigen::HouseholderQR<sc::MatX> qr(random_matrix(n, 15));
+  const Eigen::HouseholderQR<sc::MatX> qr(test_support::random_matrix(n, 15));
   const sc::MatX q = qr.householderQ();
   const sc::MatX a = q * lambda.asDiagonal() * q.transpose();
   const sc::VecX b = 3.0 * q.col(7);  // A b = lambda_7 b: the Krylov space is span(b)
@@ -102,7 +93,7 @@ TEST(LanczosSqrt, FullKrylovSpaceIsExact) {
   // Tolerance below rounding: the run ends when the space is all of R^n, y_n = A^(1/2) b.
   const Eigen::Index n = 6;
   const KnownSpectrum m = with_eigenvalues(log_spaced(n, 10.0), 16);
-  const sc::VecX b = random_matrix(n, 17).col(0);
+  const sc::VecX b = test_support::random_matrix(n, 17).col(0);
   const auto result = sc::lanczos_sqrt([&](const sc::VecX& v) { return sc::VecX(m.a * v); }, b, {1e-300, 50});
   ASSERT_TRUE(result.converged());
   EXPECT_LE(result.iterations, n);
@@ -122,7 +113,7 @@ TEST(LanczosSqrt, ZeroVectorCostsNothing) {
 TEST(LanczosSqrt, ReportsMaxIterationsWithTheLastIterate) {
   const Eigen::Index n = 60;
   const KnownSpectrum m = with_eigenvalues(log_spaced(n, 1e4), 18);
-  const sc::VecX b = random_matrix(n, 19).col(0);
+  const sc::VecX b = test_support::random_matrix(n, 19).col(0);
   int applications = 0;
   const auto result = sc::lanczos_sqrt(CountingOperator{&m.a, &applications}, b, {1e-12, 3});
   EXPECT_EQ(result.status, sc::LanczosStatus::max_iterations);

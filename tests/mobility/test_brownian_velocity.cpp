@@ -48,15 +48,6 @@ sc::FreeDrainingMobility mixed_free_draining(std::size_t bodies, int dofs, Rng& 
   return sc::FreeDrainingMobility(shapes, shape_of_body, dofs);
 }
 
-std::vector<sc::Pose> random_poses(std::size_t n, double box, Rng& rng) {
-  std::vector<sc::Pose> poses(n);
-  for (sc::Pose& p : poses) {
-    p.x = test_support::uniform_vector(rng, 0.0, box);
-    p.q = test_support::random_rotation(rng);
-  }
-  return poses;
-}
-
 // Columns B e_j of the model's square root.
 template <typename M>
 sc::MatX sqrt_matrix(M& model) {
@@ -108,7 +99,7 @@ TEST(FreeDrainingSqrt, SquaresToTheMobilityBlockByBlock) {
     SCOPED_TRACE(dofs);
     Rng rng(7);
     sc::FreeDrainingMobility model = mixed_free_draining(9, dofs, rng);
-    const std::vector<sc::Pose> poses = random_poses(9, 10.0, rng);
+    const std::vector<sc::Pose> poses = sc::random_poses(9, 0.0, 10.0, rng);
     model.set_configuration(poses);
     model.reset_applications();
     const sc::MatX B = sqrt_matrix(model);
@@ -128,7 +119,7 @@ TEST(FreeDrainingSqrt, TranslatingSphereIsTheScalarStokesEinsteinRoot) {
   const double a = 0.4, eta = 2.5;
   sc::FreeDrainingMobility model(sc::sphere_mobility({a}, eta), 5, 3);
   Rng rng(8);
-  model.set_configuration(random_poses(5, 4.0, rng));
+  model.set_configuration(sc::random_poses(5, 0.0, 4.0, rng));
   sc::GaussianStream w(9);
   const sc::VecX W = w.vector(15);
   const sc::VecX expected = std::sqrt(1.0 / (6.0 * kPi * eta * a)) * W;
@@ -151,7 +142,7 @@ TEST(MobilitySqrt, LanczosMatchesDenseRootOfRpySpheres) {
   for (const int dofs : {3, 6}) {
     Rng rng(21);
     sc::RpyMobility model(40, {1.0, 1.0}, dofs);
-    model.set_configuration(random_poses(40, 10.0, rng));  // packing ~0.17
+    model.set_configuration(sc::random_poses(40, 0.0, 10.0, rng));  // packing ~0.17
     const sc::MatX root = dense_sqrt(model.dense_matrix());
     sc::GaussianStream w(22);
     const sc::VecX W = w.vector(model.size());
@@ -173,7 +164,7 @@ TEST(MobilitySqrt, LanczosMatchesDenseRootOfRpySpheres) {
 TEST(MobilitySqrt, ExactModelsSkipLanczos) {
   Rng rng(23);
   sc::FreeDrainingMobility model = mixed_free_draining(4, 6, rng);
-  model.set_configuration(random_poses(4, 5.0, rng));
+  model.set_configuration(sc::random_poses(4, 0.0, 5.0, rng));
   sc::GaussianStream w(24);
   const sc::VecX W = w.vector(24);
   model.reset_applications();
@@ -187,7 +178,7 @@ TEST(MobilitySqrt, ExactModelsSkipLanczos) {
 TEST(MobilitySqrt, UnconvergedLanczosThrowsAfterCountedApplications) {
   Rng rng(25);
   sc::RpyMobility model(30, {1.0, 1.0}, 3);
-  model.set_configuration(random_poses(30, 8.0, rng));
+  model.set_configuration(sc::random_poses(30, 0.0, 8.0, rng));
   sc::GaussianStream w(26);
   model.reset_applications();
   EXPECT_THROW(sc::mobility_sqrt(model, w.vector(90), {1e-10, 3}), std::runtime_error);
@@ -199,9 +190,9 @@ TEST(BrownianVelocity, IsScaledSquareRootOfTheGivenNoise) {
   const double kT = 0.7, dt = 0.01;
   Rng rng(27);
   sc::FreeDrainingMobility free_draining = mixed_free_draining(3, 6, rng);
-  free_draining.set_configuration(random_poses(3, 5.0, rng));
+  free_draining.set_configuration(sc::random_poses(3, 0.0, 5.0, rng));
   sc::RpyMobility rpy(6, {1.0, 1.0}, 3);
-  rpy.set_configuration(random_poses(6, 5.0, rng));
+  rpy.set_configuration(sc::random_poses(6, 0.0, 5.0, rng));
   const auto check = [&](auto& model) {
     sc::GaussianStream stream(28), copy(28);
     const sc::VecX W = copy.vector(model.size());
@@ -217,21 +208,21 @@ TEST(BrownianVelocity, IsScaledSquareRootOfTheGivenNoise) {
 TEST(BrownianVelocity, CovarianceIsTwoKtMobilityOverDtExactRoot) {
   Rng rng(29);
   sc::FreeDrainingMobility model = mixed_free_draining(3, 6, rng);  // sphere, rod, coupled body
-  model.set_configuration(random_poses(3, 5.0, rng));
+  model.set_configuration(sc::random_poses(3, 0.0, 5.0, rng));
   expect_covariance(model, 1.7, 0.05, 20000, 30);
 }
 
 TEST(BrownianVelocity, CovarianceIsTwoKtMobilityOverDtLanczos) {
   Rng rng(31);
   sc::RpyMobility model(4, {1.0, 1.0}, 3);
-  model.set_configuration(random_poses(4, 3.0, rng));  // close and overlapping spheres
+  model.set_configuration(sc::random_poses(4, 0.0, 3.0, rng));  // close and overlapping spheres
   expect_covariance(model, 1.7, 0.05, 10000, 32, {1e-8, 100});
 }
 
 TEST(BrownianVelocity, ZeroTemperatureCostsNothing) {
   sc::RpyMobility model(5, {1.0, 1.0}, 6);
   Rng rng(33);
-  model.set_configuration(random_poses(5, 5.0, rng));
+  model.set_configuration(sc::random_poses(5, 0.0, 5.0, rng));
   model.reset_applications();
   sc::GaussianStream stream(34), fresh(34);
   const sc::MobilitySqrtProduct u = sc::brownian_velocity(model, 0.0, 0.1, stream);

@@ -62,15 +62,6 @@ class SineMobility {
 static_assert(sc::MobilityOperator<SineMobility>);
 static_assert(!sc::ExactDivergenceMobility<SineMobility>);
 
-std::vector<sc::Pose> random_poses(std::size_t n, double box, Rng& rng) {
-  std::vector<sc::Pose> poses(n);
-  for (sc::Pose& p : poses) {
-    p.x = test_support::uniform_vector(rng, 0.0, box);
-    p.q = test_support::random_rotation(rng);
-  }
-  return poses;
-}
-
 sc::Mat3 cross_matrix(const sc::Vec3& r) {
   sc::Mat3 m;
   m << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
@@ -118,7 +109,7 @@ double expect_rfd_mean(M& model, const std::vector<sc::Pose>& poses, double kT, 
 TEST(RandomFiniteDifference, MeanIsTheClosedFormDivergence) {
   Rng rng(41);
   SineMobility model(4, 0.5, 0.8, 1.3);
-  const std::vector<sc::Pose> poses = random_poses(4, 3.0, rng);
+  const std::vector<sc::Pose> poses = sc::random_poses(4, 0.0, 3.0, rng);
   model.set_configuration(poses);
   const double kT = 2.0;
   const sc::VecX exact = kT * model.closed_form_divergence();
@@ -131,7 +122,7 @@ TEST(RandomFiniteDifference, MeanIsTheClosedFormDivergence) {
 TEST(RandomFiniteDifference, MeanDoesNotDependOnTheLengthScale) {
   Rng rng(43);
   SineMobility model(3, 0.5, 0.8, 1.3);
-  const std::vector<sc::Pose> poses = random_poses(3, 3.0, rng);
+  const std::vector<sc::Pose> poses = sc::random_poses(3, 0.0, 3.0, rng);
   model.set_configuration(poses);
   const sc::VecX exact = 0.3 * model.closed_form_divergence();
   expect_rfd_mean(model, poses, 0.3, exact, 20000, 44, {1e-3, 0.25}, 1e-6);
@@ -141,7 +132,7 @@ TEST(RandomFiniteDifference, MeanDoesNotDependOnTheLengthScale) {
 TEST(RandomFiniteDifference, CostsTwoApplicationsAndRestoresTheConfiguration) {
   Rng rng(45);
   sc::RpyMobility model(5, {1.0, 1.0}, 6);
-  const std::vector<sc::Pose> poses = random_poses(5, 4.0, rng);
+  const std::vector<sc::Pose> poses = sc::random_poses(5, 0.0, 4.0, rng);
   model.set_configuration(poses);
   const sc::MatX before = model.dense_matrix();
   model.reset_applications();
@@ -157,9 +148,26 @@ TEST(RandomFiniteDifference, CostsTwoApplicationsAndRestoresTheConfiguration) {
 TEST(RandomFiniteDifference, RpyDriftVanishesOnAverage) {
   Rng rng(47);
   sc::RpyMobility model(4, {1.0, 1.0}, 6);
-  const std::vector<sc::Pose> poses = random_poses(4, 3.0, rng);  // some pairs overlap
+  const std::vector<sc::Pose> poses = sc::random_poses(4, 0.0, 3.0, rng);  // some pairs overlap
   model.set_configuration(poses);
   expect_rfd_mean(model, poses, 1.0, sc::VecX::Zero(24), 10000, 48, {1e-4, 1.0}, 1e-6);
+}
+
+// RpyMobility says so itself (divergence() = 0, checked by the test above): thermal_drift
+// then costs no application and draws nothing.
+TEST(ThermalDrift, RpyUsesItsExactZeroDivergence) {
+  static_assert(sc::ExactDivergenceMobility<sc::RpyMobility>);
+  Rng rng(50);
+  sc::RpyMobility model(4, {1.0, 1.0}, 6);
+  const std::vector<sc::Pose> poses = sc::random_poses(4, 0.0, 3.0, rng);
+  model.set_configuration(poses);
+  model.reset_applications();
+  sc::GaussianStream stream(51);
+  const sc::VecX drift = sc::thermal_drift(model, poses, 1.0, stream);
+  EXPECT_EQ(drift, sc::VecX::Zero(24));
+  EXPECT_EQ(model.applications(), 0u);
+  sc::GaussianStream fresh(51);
+  EXPECT_EQ(stream(), fresh());  // nothing drawn
 }
 
 // The free-draining closed form, against the drift of a tracking point off a sphere's centre:
@@ -171,7 +179,7 @@ TEST(FreeDrainingDivergence, OffCentreSphereDriftsTowardsItsCentre) {
   const sc::Vec3 r(0.4, -0.7, 0.25);
   sc::FreeDrainingMobility model(off_centre_sphere(a, b, r), 3, 6);
   Rng rng(49);
-  const std::vector<sc::Pose> poses = random_poses(3, 5.0, rng);
+  const std::vector<sc::Pose> poses = sc::random_poses(3, 0.0, 5.0, rng);
   model.set_configuration(poses);
   const sc::VecX divergence = model.divergence();
   for (std::size_t i = 0; i < 3; ++i) {
@@ -192,11 +200,11 @@ TEST(FreeDrainingDivergence, VanishesWithoutAntisymmetricCoupling) {
                                      symmetric_coupling, off_centre_sphere(0.3, 0.9, {0.4, 0.1, 0.0})};
   for (const int dofs : {6, 3}) {
     sc::FreeDrainingMobility model(shapes, {0, 1, 2, 1, 0, 2}, dofs);
-    model.set_configuration(random_poses(6, 5.0, rng));
+    model.set_configuration(sc::random_poses(6, 0.0, 5.0, rng));
     EXPECT_LT(model.divergence().cwiseAbs().maxCoeff(), 1e-17) << dofs;
   }
   sc::FreeDrainingMobility translation_only(shapes, {3, 3}, 3);  // off-centre, but no rotations
-  translation_only.set_configuration(random_poses(2, 5.0, rng));
+  translation_only.set_configuration(sc::random_poses(2, 0.0, 5.0, rng));
   EXPECT_EQ(translation_only.divergence(), sc::VecX::Zero(6));
 }
 
@@ -210,7 +218,7 @@ TEST(FreeDrainingDivergence, AgreesWithTheRandomFiniteDifference) {
                                      off_centre_sphere(0.3, 0.9, {0.4, -0.7, 0.25}),
                                      sc::spherocylinder_mobility({3.0, 0.5}, 1.0)};
   sc::FreeDrainingMobility model(shapes, {0, 1, 2}, 6);
-  const std::vector<sc::Pose> poses = random_poses(3, 5.0, rng);
+  const std::vector<sc::Pose> poses = sc::random_poses(3, 0.0, 5.0, rng);
   model.set_configuration(poses);
   const double kT = 1.5;
   const sc::VecX exact = kT * model.divergence();
@@ -224,7 +232,7 @@ TEST(FreeDrainingDivergence, AgreesWithTheRandomFiniteDifference) {
 TEST(ThermalDrift, UsesTheExactDivergenceWhenTheModelHasOne) {
   Rng rng(53);
   sc::FreeDrainingMobility model(off_centre_sphere(0.3, 0.9, {0.4, -0.7, 0.25}), 4, 6);
-  const std::vector<sc::Pose> poses = random_poses(4, 5.0, rng);
+  const std::vector<sc::Pose> poses = sc::random_poses(4, 0.0, 5.0, rng);
   model.set_configuration(poses);
   model.reset_applications();
   sc::GaussianStream stream(54), fresh(54);
@@ -242,7 +250,7 @@ TEST(ThermalDrift, UsesTheExactDivergenceWhenTheModelHasOne) {
 TEST(ThermalDrift, ZeroTemperatureCostsNothing) {
   Rng rng(56);
   SineMobility model(2, 0.5, 0.8, 1.3);
-  const std::vector<sc::Pose> poses = random_poses(2, 3.0, rng);
+  const std::vector<sc::Pose> poses = sc::random_poses(2, 0.0, 3.0, rng);
   model.set_configuration(poses);
   sc::GaussianStream stream(57), fresh(57);
   EXPECT_EQ(sc::thermal_drift(model, poses, 0.0, stream), sc::VecX::Zero(6));
@@ -252,7 +260,7 @@ TEST(ThermalDrift, ZeroTemperatureCostsNothing) {
 
 TEST(ThermalDrift, RejectsBadInputNamingTheField) {
   Rng rng(58);
-  std::vector<sc::Pose> poses = random_poses(3, 3.0, rng);
+  std::vector<sc::Pose> poses = sc::random_poses(3, 0.0, 3.0, rng);
   SineMobility sine(3, 0.5, 0.8, 1.3);
   sine.set_configuration(poses);
   sc::FreeDrainingMobility free_draining(sc::sphere_mobility({0.5}, 1.0), 3, 6);

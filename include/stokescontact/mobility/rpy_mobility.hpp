@@ -83,6 +83,11 @@ class RpyMobility {
 
   Eigen::Index size() const { return dofs_ * n_; }
   int dofs_per_body() const { return dofs_; }
+  // div_q M = 0 exactly: RPY between spheres is divergence free in the positions (sum_j
+  // d/dx_j M_ij vanishes on both branches, the rotation couplings' divergence contracts an
+  // antisymmetric tensor) and nothing depends on orientation. The thermal drift is then free
+  // (thermal_drift.hpp), where a random finite difference would cost two applications.
+  VecX divergence() const { return VecX::Zero(size()); }
   std::size_t applications() const { return counter_.applications(); }
   void reset_applications() { counter_.reset_applications(); }
   const RpyParameters& parameters() const { return parameters_; }
