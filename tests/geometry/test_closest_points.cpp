@@ -229,6 +229,44 @@ TEST(ClosestPoints, InvariantUnderCommonRigidMotion) {
   for_each_shape_pair([]<sc::Shape A, sc::Shape B>(unsigned seed) { check_rigid_motion<A, B>(seed); }, 30);
 }
 
+// Pair 3417 of the boomerang-boomerang rigid-motion loop: the distance is realised by the
+// bend of a against an end of b's first arm, a smooth minimum along the bend. The search
+// polished it to its slope root, then kept bisecting around it, and a sample ~ 2e-7 away
+// along the bend, where f is flat, won by a unit in the last place after the motion only:
+// the normal turned by 1.7e-7. The polished root now wins such ties.
+TEST(ClosestPoints, RigidMotionKeepsTheWitnessOfAFlatArcMinimum) {
+  const sc::Boomerang a{0.22677989786602071, 0.16761529286314439, 1.0691300646695687};
+  const sc::Boomerang b{0.46014601093744678, 0.77952611603344302, 0.909468368121646};
+  // sc::Quat(w, x, y, z)
+  const Pose pa{Vec3(0.55389556119651484, -1.1394649651714293, -0.26075042321443598),
+                sc::Quat(0.27791744729037599, -0.63940090078661527, -0.064973399661559947,
+                         -0.71393755882519949)};
+  const Pose pb{Vec3(1.5049513797770899, -0.59481454331578443, 0.57801217447732189),
+                sc::Quat(-0.14351310588149904, -0.65276437091000372, -0.66544676646384049,
+                         0.33239023077330637)};
+  const Pose g{Vec3(4.6535182691426655, -6.2313666254944717, -0.43173253634294184),
+               sc::Quat(-0.14606459571494926, -0.77599605691453655, 0.58459670630776028,
+                        -0.18639191105259406)};
+  const Pose ga{g.to_world(pa.x), (g.q * pa.q).normalized()};
+  const Pose gb{g.to_world(pb.x), (g.q * pb.q).normalized()};
+  const sc::ClosestPoints before = sc::closest_points(a, pa, b, pb);
+  const sc::ClosestPoints after = sc::closest_points(a, ga, b, gb);
+  EXPECT_NEAR(before.distance, 0.24091853324732915, 1e-12);
+  EXPECT_NEAR(before.distance, after.distance, 1e-12);
+  EXPECT_LE((g.q * before.normal - after.normal).norm(), 1e-9);
+  EXPECT_LE((g.to_world(before.point_a) - after.point_a).norm(), 1e-9);
+  EXPECT_LE((g.to_world(before.point_b) - after.point_b).norm(), 1e-9);
+  EXPECT_LE((g.to_world(before.curve_point_a) - after.curve_point_a).norm(), 1e-9);
+  EXPECT_LE((g.to_world(before.curve_point_b) - after.curve_point_b).norm(), 1e-9);
+  // The bend's witness is the slope root: the curve points' offset is normal to the bend.
+  const auto ca = sc::to_world(sc::centre_curve(a), pa);
+  const sc::Arc& bend = ca.arcs[0];
+  const Vec3 offset = before.curve_point_b - before.curve_point_a;
+  const double t = std::atan2((before.curve_point_a - bend.centre).dot(bend.e2),
+                              (before.curve_point_a - bend.centre).dot(bend.e1));
+  EXPECT_LE(std::abs(offset.normalized().dot(bend.tangent(t))), 1e-12);
+}
+
 TEST(ClosestPoints, SpheresInClosedForm) {
   const sc::Sphere a{1.0}, b{0.5};
   const Pose pa{Vec3(1, 2, 3), sc::Quat::Identity()};

@@ -485,7 +485,20 @@ PieceClosestPoints minimise_along_arc(const Arc& arc, const Target& target, doub
     push(iv.left, k);
     push(k, iv.right);
   }
-  const Sample& s = samples[best];
+  // The witness: the lowest sample, unless a polished minimum (or seed) lies within tau of
+  // it. The search goes on bisecting around a polished minimum until its bounds clear tau,
+  // and f is flat there to second order: samples up to ~ sqrt(tau / R) away along t tie
+  // with it to rounding, and one that wins by a unit in the last place would move the
+  // witness by ~ 1e-7 (and with it the normal), differently under a rigid motion. The slope
+  // root places the polished one to rounding, so it wins such ties; its distance is within
+  // tau of the lowest.
+  int pick = best;
+  for (int i = 0; i < count; ++i) {
+    if (polished[i] && samples[i].f <= best_f + tau &&
+        (!polished[pick] || samples[i].f < samples[pick].f))
+      pick = i;
+  }
+  const Sample& s = samples[pick];
   return {s.t, s.u, s.point, s.target_point, s.f};
 }
 
