@@ -16,13 +16,13 @@
 
 namespace sc = stokescontact;
 
-// The Brownian slot: free-draining offers an exact square root and divergence, RPY neither
-// (it gets the Lanczos and RFD fallbacks); both stay plain MobilityOperators.
+// The Brownian slot: free-draining offers an exact square root and divergence, RPY only its
+// (zero) divergence (it gets the Lanczos square root); both stay plain MobilityOperators.
 static_assert(sc::SquareRootMobility<sc::FreeDrainingMobility>);
 static_assert(sc::ExactDivergenceMobility<sc::FreeDrainingMobility>);
 static_assert(sc::DenseMobilityOperator<sc::FreeDrainingMobility>);
 static_assert(!sc::SquareRootMobility<sc::RpyMobility>);
-static_assert(!sc::ExactDivergenceMobility<sc::RpyMobility>);
+static_assert(sc::ExactDivergenceMobility<sc::RpyMobility>);
 static_assert(sc::DenseMobilityOperator<sc::RpyMobility>);
 
 namespace {
