@@ -188,7 +188,8 @@ TEST(RpyDirectSum, InstructionSetsAgreeToRounding) {
 // Each blob sums its sources in one order, whatever the number of threads.
 TEST(RpyDirectSum, ThreadCountDoesNotChangeTheSum) {
   std::mt19937 rng(kSeed + 3);
-  const sc::Mat3X x = random_blobs(1100, 15.0, rng);  // 9 blocks
+  const sc::Mat3X x = random_blobs(1100, 15.0, rng);
+  ASSERT_GE(sc::detail::rpy_blocks(x.cols()).count, sc::detail::kRpyParallelMinBlocks);  // runs in parallel
   const int threads = omp_get_max_threads();
   for (const int dofs : {3, 6}) {
     const sc::VecX F = random_vector(dofs * x.cols(), rng);

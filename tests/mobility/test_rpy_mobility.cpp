@@ -188,8 +188,8 @@ TEST(RpyMobility, ThreeDofModelIsTranslationBlockOfSixDofModel) {
 // Each target sums its sources in one order, whatever the number of threads.
 TEST(RpyMobility, ApplyDoesNotDependOnThreadCount) {
   sc::Rng rng(kSeed + 5);
-  sc::RpyMobility m(700, {1.0, 1.0}, 6);
-  m.set_configuration(random_poses(700, 0.0, 12.0, rng));
+  sc::RpyMobility m(1000, {1.0, 1.0}, 6);  // 8 blocks: the sum runs in parallel
+  m.set_configuration(random_poses(1000, 0.0, 14.0, rng));
   const sc::VecX F = random_vector(m.size(), rng);
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);

@@ -242,6 +242,11 @@ inline RpyBlocks rpy_blocks(Eigen::Index n) {
   return {count, (per_block + kRpyLanes - 1) / kRpyLanes * kRpyLanes};
 }
 
+// Fewer blocks (n <= 896, a product of at most ~1 ms on one core) run on one thread: a
+// parallel region costs microseconds on idle cores but can wait milliseconds for a thread
+// that another process has descheduled.
+inline constexpr Eigen::Index kRpyParallelMinBlocks = 8;
+
 // Rows per panel: the column buffers of a panel (rows x blocks x tile outputs) stay within
 // kRpyPanelDoubles, so memory stays O(n) for large n; small scenes run as one panel.
 inline constexpr Eigen::Index kRpyPanelDoubles = Eigen::Index{1} << 21;  // 16 MB
@@ -277,7 +282,7 @@ void rpy_direct_sum_blocks(const Mat3X& x, const VecX& F, VecX& U, RpyInstructio
   for (Eigen::Index first = 0; first < blocks; first += panel) {
     const Eigen::Index last = std::min(blocks, first + panel);
 #ifdef _OPENMP
-#pragma omp parallel for schedule(dynamic, 1) if (blocks >= 3)
+#pragma omp parallel for schedule(dynamic, 1) if (blocks >= kRpyParallelMinBlocks)
 #endif
     for (Eigen::Index i = first; i < last; ++i) {  // longest rows first
       double* row = rows.data() + i * acc_size;
