@@ -70,7 +70,7 @@ void time_applications(benchmark::State& state, Model& model, Eigen::Index n) {
       static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
-// Blob centres (in blob radii) and forces of the RPY scene.
+// Blob centres (in blob radii) of the RPY scene.
 Mat3X random_blobs(Eigen::Index n) {
   const std::vector<Pose> poses = random_poses(n, 42);
   Mat3X x(3, n);

@@ -23,6 +23,7 @@
 // changes results only by rounding). Users need no special flags for the speed.
 #include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
