@@ -5,13 +5,15 @@
 //
 //   fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500]
 //                [--solver NAME] [--mobility multiblob|rpy|free-draining]
-//                [--d-try-multiplier 1] [--tol TOL] [--cost formed|matrix-free]
+//                [--d-try-multiplier 1] [--d-try-rule absolute|relative] [--tol TOL]
+//                [--cost formed|matrix-free]
 //                [--separation-margin 1e-3] [--pairs] [--output FILE] [--table1]
 //
 // Prints one JSON object per configuration (to --output if given, else stdout), then a
 // summary table per phi. --tol sets the eq. 29 TOL of the barrier and default solvers (without
 // it each keeps its own: barrier 1e-2, the paper's). --pairs adds per-pair distances and
-// forces (Fig. 4c, 4e, 5).
+// forces (Fig. 4c, 4e, 5). --d-try-rule: absolute is the paper's eq. 31 (the default here, as
+// the paper's figures use it), relative the library's default (per pair, Galilean invariant).
 // --table1: the Sec. 3.1.2 sweep d_try x {1, 1.1, 1.2}, TOL in {1e-2, 5e-3, 5e-6} on the
 // first --phi (default 0.24), solver default barrier-slsqp (the paper's), contact forces
 // compared with the reference (d_try x 1, TOL 5e-6).
@@ -38,7 +40,8 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500] [--solver NAME]\n"
-    "                    [--mobility multiblob|rpy|free-draining] [--d-try-multiplier 1] [--tol TOL]\n"
+    "                    [--mobility multiblob|rpy|free-draining] [--d-try-multiplier 1]\n"
+    "                    [--d-try-rule absolute|relative] [--tol TOL]\n"
     "                    [--cost formed|matrix-free] [--separation-margin 1e-3] [--pairs] [--output FILE]\n"
     "                    [--table1]\n";
 
@@ -72,6 +75,10 @@ Options parse(int argc, char** argv) {
   o.solver = sc::contact_solver_from_name(args.text("--solver", o.table1 ? "barrier-slsqp" : "default"));
   o.mobility = ex::parse_mobility(args.text("--mobility", "multiblob"));
   o.step.d_try_multiplier = args.number("--d-try-multiplier", 1.0, 1.0);
+  const std::string rule = args.text("--d-try-rule", "absolute");
+  if (rule != "absolute" && rule != "relative")
+    throw std::invalid_argument("--d-try-rule must be absolute or relative, got '" + rule + "'");
+  o.step.d_try_rule = rule == "relative" ? sc::DTryRule::relative : sc::DTryRule::absolute;
   // TOL (eq. 29) replaces the solver's own when given (barrier: 1e-2, the paper's).
   o.step.tol = args.positive("--tol");
   o.step.options.cost = parse_cost(args.text("--cost", "matrix-free"));

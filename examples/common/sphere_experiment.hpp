@@ -124,6 +124,9 @@ sc::VecX unconstrained_velocities(M& mobility, const SphereScene& scene) {
 
 struct StepSettings {
   double d_try_multiplier = 1.0;  // Sec. 3.1.2: 1, 1.1, 1.2
+  // The paper's eq. 31 (one threshold from the fastest sphere), as its figures and tables
+  // use; relative: the library's default, one threshold per pair from its relative motion.
+  sc::DTryRule d_try_rule = sc::DTryRule::absolute;
   std::optional<double> tol;      // eq. 29 TOL for solvers that have one; none: the solver's own
   sc::ContactStepOptions options;  // cost mode, separation margin
   bool pair_details = false;       // keep per-pair distances and forces (Fig. 4c, 4e, 5)
@@ -177,7 +180,7 @@ StepRecord run_step(const sc::ContactSolver& solver, const SphereScene& scene, M
                     const StepSettings& settings) {
   const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
   const sc::ContactStepProblem<sc::Sphere> problem{shapes, scene.packing.poses, U, kTimeStep, scene.d_hat,
-                                                   0.0,    settings.d_try_multiplier, {}};
+                                                   0.0,    settings.d_try_multiplier, {}, settings.d_try_rule};
   // TOL replaces the solver's own where it has one (default, barrier); the LCP sequence keeps
   // stopping at its first separated iterate.
   sc::ContactSolver chosen = solver;
