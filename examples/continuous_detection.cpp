@@ -17,7 +17,7 @@
 //   whole contact steps with whole_step on and off (median of --repeats); the extra time of
 //   whole_step over the free-draining unconstrained step and, for N <= 1e4, over one RPY
 //   application (the unconstrained step with hydrodynamics).
-// One JSON object per line (to --output if given, else stdout), then a summary on stderr.
+// One JSON object per line (to --output if given, else stdout) and a readable summary on stdout.
 #include <stokescontact/stokescontact.hpp>
 
 #include <algorithm>
@@ -91,7 +91,7 @@ void tunnelling_case(ex::JsonLines& sink, const std::string& name, const std::ve
               ", \"carried\": " + std::to_string(r.carried_pairs) + ", \"applications\": " +
               std::to_string(r.mobility_applications) + ", \"min_d_over_d_hat\": " +
               sc::json_number(r.min_distance_ratio) + ", \"passed_through\": " + (passed ? "true" : "false") + "}");
-    std::fprintf(stderr, "%-34s %-17s dt %-6g %-17s flagged %zu carried %zu apps %2zu  %s\n", name.c_str(), mode.name,
+    std::printf("%-34s %-17s dt %-6g %-17s flagged %zu carried %zu apps %2zu  %s\n", name.c_str(), mode.name,
                  dt, std::string(sc::to_string(r.status)).c_str(), r.flagged_pairs, r.carried_pairs,
                  r.mobility_applications,
                  !passed ? "held"
@@ -101,7 +101,7 @@ void tunnelling_case(ex::JsonLines& sink, const std::string& name, const std::ve
 }
 
 void tunnelling(ex::JsonLines& sink) {
-  std::fprintf(stderr, "\nTunnelling: one contact step, free draining\n");
+  std::printf("\nTunnelling: one contact step, free draining\n");
   {  // Head-on unit spheres at x = 0 and 2.2, +-10.
     const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
     const std::vector<sc::Pose> poses{{sc::Vec3::Zero(), sc::Quat::Identity()}, {sc::Vec3(2.2, 0, 0), sc::Quat::Identity()}};
@@ -147,7 +147,7 @@ void tunnelling(ex::JsonLines& sink) {
               "\"time_stepper\", \"dt\": " + sc::json_number(dt) + ", \"substeps\": " + std::to_string(d.substeps) +
               ", \"applications\": " + std::to_string(d.mobility_applications) + ", \"min_d_over_d_hat\": " +
               sc::json_number(d.min_distance_ratio) + "}");
-    std::fprintf(stderr, "%-34s %-17s dt %-6g %-17s substeps %zu apps %2zu min d/d_hat %.6f  held\n",
+    std::printf("%-34s %-17s dt %-6g %-17s substeps %zu apps %2zu min d/d_hat %.6f  held\n",
                  "boomerang spinning through another", "time_stepper", dt, std::string(sc::to_string(d.status)).c_str(),
                  d.substeps, d.mobility_applications, d.min_distance_ratio);
   }
@@ -160,7 +160,7 @@ std::vector<sc::Pose> shifted_poses(const std::vector<sc::Pose>& poses, const sc
 }
 
 void galilean(ex::JsonLines& sink, int repeats) {
-  std::fprintf(stderr, "\nGalilean invariance: 1000 spheres in simple shear u = y e_x, dt 0.01, d_hat 0.01\n");
+  std::printf("\nGalilean invariance: 1000 spheres in simple shear u = y e_x, dt 0.01, d_hat 0.01\n");
   const sc::SpherePacking packing = sc::random_sequential_addition(1000, 0.2, 5);
   const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
   const double dt = 0.01;
@@ -185,7 +185,7 @@ void galilean(ex::JsonLines& sink, int repeats) {
                 sc::json_number(centre) + ", \"flagged\": " + std::to_string(flagged.size()) +
                 ", \"same_as_centre_0\": " + (flagged == reference ? "true" : "false") +
                 ", \"step_s\": " + sc::json_number(t) + "}");
-      std::fprintf(stderr, "%-17s centre y %-6g flagged %7zu  same set as at 0: %-3s  step %.4f s\n", mode.name, centre,
+      std::printf("%-17s centre y %-6g flagged %7zu  same set as at 0: %-3s  step %.4f s\n", mode.name, centre,
                    flagged.size(), flagged == reference ? "yes" : "no", t);
     }
   }
@@ -264,7 +264,7 @@ void overhead(ex::JsonLines& sink, const std::vector<std::size_t>& sizes, int re
               sc::json_number(t_interior) + ", \"step_end_of_step_s\": " + sc::json_number(t_step[0]) +
               ", \"step_whole_step_s\": " + sc::json_number(t_step[1]) + ", \"extra_over_unconstrained\": " +
               sc::json_number(extra) + ", \"rpy_apply_s\": " + (t_rpy > 0.0 ? sc::json_number(t_rpy) : "null") + "}");
-    std::fprintf(stderr, "%8zu | %9.4fs | %9.4fs %9.4fs %9.4fs | %9.4fs %9.4fs | %6zu %5.0f%% | %9.4fs %5.1f%%\n", n,
+    std::printf("%8zu | %9.4fs | %9.4fs %9.4fs %9.4fs | %9.4fs %9.4fs | %6zu %5.0f%% | %9.4fs %5.1f%%\n", n,
                  t_free, t_eq31, t_rel, t_interior, t_step[0], t_step[1], nc_step, 100.0 * extra, t_rpy,
                  t_rpy > 0.0 ? 100.0 * (t_step[1] - t_step[0]) / t_rpy : 0.0);
   }

@@ -18,10 +18,15 @@
 // spheres). Its broad phase tests, in the mean-velocity frame, the balls that hold each
 // body's bounding ball over the step: centre x_i + (dt/2)(u_i - u_mean), radius r_i +
 // (dt/2)|u_i - u_mean| (a bounding ball about the centre does not move under rotation).
+//
+// Both broad phases keep a few fast bodies from coarsening the cell list for all: a body
+// whose grown ball is more than twice the largest bounding radius is tested against every
+// body (detail::swept_candidates).
 #include <algorithm>
 #include <cmath>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "stokescontact/contact/contact_pairs.hpp"
@@ -50,6 +55,41 @@ inline Vec3 mean_velocity(const VecX& U, std::size_t bodies, int dofs_per_body) 
   return bodies == 0 ? sum : Vec3(sum / static_cast<double>(bodies));
 }
 
+// Candidate pairs (i < j, sorted) of balls grown by each body's motion over the step. A few
+// fast bodies would set the cell size for everyone (cells are 2 max radius + cutoff wide):
+// balls more than twice the largest body's own bounding radius are tested against every
+// body instead, O(N) each, as long as there are at most 64 of them.
+inline std::vector<BodyPair> swept_candidates(const Mat3X& centres, const VecX& radii, double body_radius,
+                                              double cutoff, const std::optional<PeriodicBox>& box, CellList& list) {
+  const auto n = centres.cols();
+  std::vector<Eigen::Index> slow, fast;
+  for (Eigen::Index k = 0; k < n; ++k) (radii[k] > 2.0 * body_radius ? fast : slow).push_back(k);
+  if (fast.empty() || fast.size() > 64) return list.find_pairs(centres, radii, cutoff, box);
+  Mat3X slow_centres(3, static_cast<Eigen::Index>(slow.size()));
+  VecX slow_radii(static_cast<Eigen::Index>(slow.size()));
+  for (std::size_t k = 0; k < slow.size(); ++k) {
+    slow_centres.col(static_cast<Eigen::Index>(k)) = centres.col(slow[k]);
+    slow_radii[static_cast<Eigen::Index>(k)] = radii[slow[k]];
+  }
+  std::vector<BodyPair> out;
+  for (const BodyPair& p : list.find_pairs(slow_centres, slow_radii, cutoff, box))
+    out.push_back({slow[static_cast<std::size_t>(p.i)], slow[static_cast<std::size_t>(p.j)]});
+  const double r_max = radii.maxCoeff();
+  for (const Eigen::Index f : fast) {
+    if (box && radii[f] + r_max + cutoff > 0.5 * box->lengths.minCoeff())
+      fail_argument("PeriodicBox.lengths", "body " + std::to_string(f) + " moves too far in the step for the box: " +
+                                               "its reach " + std::to_string(radii[f] + r_max + cutoff) +
+                                               " exceeds half the shortest side");
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (k == f || (radii[k] > 2.0 * body_radius && k < f)) continue;  // fast pairs once
+      if (is_candidate_pair(centres.col(f), centres.col(k), radii[f], radii[k], cutoff, box))
+        out.push_back({std::min(f, k), std::max(f, k)});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace detail
 
 // DTryRule::relative at the trial configuration `trial` = Q_t + dt Psi U.
@@ -65,6 +105,7 @@ RelativePairs find_pairs_relative(std::span<const S> shapes, std::span<const Pos
   Mat3X centres;
   VecX radii;
   detail::broad_phase_input(shapes, trial, centres, radii);
+  const double body_radius = radii.size() > 0 ? radii.maxCoeff() : 0.0;
   std::vector<RigidVelocity> v(n);
   for (std::size_t k = 0; k < n; ++k) {
     v[k] = rigid_velocity(U, k, dofs_per_body);
@@ -74,7 +115,7 @@ RelativePairs find_pairs_relative(std::span<const S> shapes, std::span<const Pos
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
   RelativePairs out;
-  for (const BodyPair& c : list.find_pairs(centres, radii, multiplier * d_hat, box)) {
+  for (const BodyPair& c : detail::swept_candidates(centres, radii, body_radius, multiplier * d_hat, box, list)) {
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const S& si = shape_of(shapes, i);
     const S& sj = shape_of(shapes, j);
@@ -114,6 +155,7 @@ std::vector<TrajectoryCrossing> trajectory_crossings(std::span<const S> shapes, 
   Mat3X centres;
   VecX radii;
   detail::broad_phase_input(shapes, poses, centres, radii);
+  const double body_radius = radii.size() > 0 ? radii.maxCoeff() : 0.0;
   std::vector<RigidVelocity> v(n);
   for (std::size_t k = 0; k < n; ++k) {
     v[k] = rigid_velocity(V, k, dofs_per_body);
@@ -124,7 +166,8 @@ std::vector<TrajectoryCrossing> trajectory_crossings(std::span<const S> shapes, 
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
   std::vector<TrajectoryCrossing> out;
-  for (const BodyPair& c : list.find_pairs(centres, radii, std::max(0.0, threshold) + tolerance, box)) {
+  const double cutoff = std::max(0.0, threshold) + tolerance;
+  for (const BodyPair& c : detail::swept_candidates(centres, radii, body_radius, cutoff, box, list)) {
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const Vec3 shift = minimum_image_shift(centres.col(c.i), centres.col(c.j), box);
     SweptDistance first = first_time_below(shape_of(shapes, i), poses[i], v[i], shape_of(shapes, j),
