@@ -5,13 +5,18 @@
 //
 //   fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500]
 //                [--solver NAME] [--mobility multiblob|rpy|free-draining]
-//                [--d-try-multiplier 1] [--tol TOL] [--cost formed|matrix-free]
-//                [--separation-margin 1e-3] [--pairs] [--output FILE] [--table1]
+//                [--d-try-multiplier 1] [--d-try-rule absolute|relative] [--tol TOL]
+//                [--cost formed|matrix-free]
+//                [--separation-margin 1e-3] [--end-of-step] [--pairs] [--output FILE] [--table1]
 //
 // Prints one JSON object per configuration (to --output if given, else stdout), then a
 // summary table per phi. --tol sets the eq. 29 TOL of the barrier and default solvers (without
 // it each keeps its own: barrier 1e-2, the paper's). --pairs adds per-pair distances and
-// forces (Fig. 4c, 4e, 5).
+// forces (Fig. 4c, 4e, 5). --d-try-rule: absolute is the paper's eq. 31 (the default here, as
+// the paper's figures use it), relative the library's default (per pair, Galilean invariant).
+// --end-of-step: the paper's check at the end of the step only (ContactStepOptions::
+// whole_step off). Every record says how many pairs overlap inside the step along the
+// returned motion (interior_overlaps) and how deep (interior_min_d_over_d_hat).
 // --table1: the Sec. 3.1.2 sweep d_try x {1, 1.1, 1.2}, TOL in {1e-2, 5e-3, 5e-6} on the
 // first --phi (default 0.24), solver default barrier-slsqp (the paper's), contact forces
 // compared with the reference (d_try x 1, TOL 5e-6).
@@ -38,8 +43,10 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500] [--solver NAME]\n"
-    "                    [--mobility multiblob|rpy|free-draining] [--d-try-multiplier 1] [--tol TOL]\n"
-    "                    [--cost formed|matrix-free] [--separation-margin 1e-3] [--pairs] [--output FILE]\n"
+    "                    [--mobility multiblob|rpy|free-draining] [--d-try-multiplier 1]\n"
+    "                    [--d-try-rule absolute|relative] [--tol TOL]\n"
+    "                    [--cost formed|matrix-free] [--separation-margin 1e-3] [--end-of-step] [--pairs]\n"
+    "                    [--output FILE]\n"
     "                    [--table1]\n";
 
 struct Options {
@@ -72,10 +79,15 @@ Options parse(int argc, char** argv) {
   o.solver = sc::contact_solver_from_name(args.text("--solver", o.table1 ? "barrier-slsqp" : "default"));
   o.mobility = ex::parse_mobility(args.text("--mobility", "multiblob"));
   o.step.d_try_multiplier = args.number("--d-try-multiplier", 1.0, 1.0);
+  const std::string rule = args.text("--d-try-rule", "absolute");
+  if (rule != "absolute" && rule != "relative")
+    throw std::invalid_argument("--d-try-rule must be absolute or relative, got '" + rule + "'");
+  o.step.d_try_rule = rule == "relative" ? sc::DTryRule::relative : sc::DTryRule::absolute;
   // TOL (eq. 29) replaces the solver's own when given (barrier: 1e-2, the paper's).
   o.step.tol = args.positive("--tol");
   o.step.options.cost = parse_cost(args.text("--cost", "matrix-free"));
   o.step.options.separation_margin = args.number("--separation-margin", o.step.options.separation_margin, 0.0);
+  o.step.options.whole_step = !args.flag("--end-of-step");
   o.step.options.validate();
   o.step.pair_details = args.flag("--pairs");
   o.output = args.text("--output", "");
@@ -113,6 +125,8 @@ std::string progress(const ex::StepRecord& r, double phi, int config) {
 struct PhiSummary {
   std::vector<double> min_after, applications, wall, nc;
   int respects = 0;  // configs with min d >= d_hat (1 - 1e-9)
+  int overlapping = 0;  // configs with a pair overlapping inside the step
+  double deepest = 0.0;  // the smallest interior d / d_hat among them
 
   void add(const ex::StepRecord& r) {
     min_after.push_back(r.min_ratio_after);
@@ -120,20 +134,26 @@ struct PhiSummary {
     wall.push_back(r.wall_time_s);
     nc.push_back(static_cast<double>(r.flagged));
     respects += r.min_ratio_after >= ex::kRespectsDHat;
+    if (r.interior_overlaps > 0) {
+      ++overlapping;
+      deepest = std::min(deepest, r.interior_min_ratio);
+    }
   }
 };
 
 void print_fig4_summary(const Options& o, const std::vector<std::pair<double, PhiSummary>>& rows) {
-  std::printf("\nFig. 4: %zu spheres, %s mobility, solver %s, cost %s, d_try x %g, TOL %s\n", o.spheres,
+  std::printf("\nFig. 4: %zu spheres, %s mobility, solver %s, cost %s, d_try x %g (%s), TOL %s, %s\n", o.spheres,
               ex::mobility_name(o.mobility), sc::contact_solver_name(o.solver).c_str(), cost_name(o),
-              o.step.d_try_multiplier, o.step.tol ? sc::json_number(*o.step.tol).c_str() : "the solver's own");
-  std::printf("%5s %7s | %-29s | %9s | %-13s | %9s | %7s\n", "phi", "configs", "min d/d_hat after (min med max)",
-              "d>=d_hat", "apps (med max)", "med wall", "med Nc");
+              o.step.d_try_multiplier, o.step.d_try_rule == sc::DTryRule::relative ? "per pair" : "eq. 31",
+              o.step.tol ? sc::json_number(*o.step.tol).c_str() : "the solver's own",
+              o.step.options.whole_step ? "whole step" : "end of step only");
+  std::printf("%5s %7s | %-29s | %9s | %-13s | %9s | %7s | %s\n", "phi", "configs", "min d/d_hat after (min med max)",
+              "d>=d_hat", "apps (med max)", "med wall", "med Nc", "overlap inside the step (configs, deepest d/d_hat)");
   for (const auto& [phi, s] : rows)
-    std::printf("%5.2f %7zu | %9.6f %9.6f %9.6f | %8.1f%% | %6.0f %6.0f | %8.3fs | %7.0f\n", phi, s.min_after.size(),
-                ex::minimum(s.min_after), ex::median(s.min_after), ex::maximum(s.min_after),
+    std::printf("%5.2f %7zu | %9.6f %9.6f %9.6f | %8.1f%% | %6.0f %6.0f | %8.3fs | %7.0f | %d, %.3g\n", phi,
+                s.min_after.size(), ex::minimum(s.min_after), ex::median(s.min_after), ex::maximum(s.min_after),
                 100.0 * s.respects / static_cast<double>(s.min_after.size()), ex::median(s.applications),
-                ex::maximum(s.applications), ex::median(s.wall), ex::median(s.nc));
+                ex::maximum(s.applications), ex::median(s.wall), ex::median(s.nc), s.overlapping, s.deepest);
 }
 
 template <sc::MobilityOperator M>

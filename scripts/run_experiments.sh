@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # The contact-solver experiments of docs/results.md (Broms & Tornberg Fig. 4, Table 1, and the
-# speed-versus-error comparison). Builds the drivers in Release, writes JSON lines to
+# speed-versus-error comparison, contact over the whole step). Builds the drivers in Release, writes JSON lines to
 # docs/data/ and the printed summaries to docs/data/*.txt. About 45 minutes on 2 cores.
-# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed] ... (default: all)
+# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step] ... (default: all)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release -DSTOKESCONTACT_BUILD_TESTS=OFF -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build --preset release -j "$(nproc 2>/dev/null || echo 2)" --target fig4_spheres speed_vs_error
+cmake --build --preset release -j "$(nproc 2>/dev/null || echo 2)" --target fig4_spheres speed_vs_error continuous_detection
 bin=build/release/examples
 data=docs/data
 mkdir -p "$data"
@@ -17,7 +17,7 @@ run() {  # name, command...
   "$@" --output "$data/$name.jsonl" | tee "$data/$name.txt"
 }
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(fig4 fig4-multiblob table1 speed)
+[ ${#parts[@]} -eq 0 ] && parts=(fig4 fig4-multiblob table1 speed whole-step)
 for part in "${parts[@]}"; do
   case $part in
     fig4)
@@ -30,6 +30,11 @@ for part in "${parts[@]}"; do
       run table1_rpy_barrier_slsqp $bin/fig4_spheres --table1 --mobility rpy --solver barrier-slsqp --configs 10 ;;
     speed)
       run speed_vs_error $bin/speed_vs_error --mobility rpy --configs 10 --jammed-spheres 100 ;;
+    whole-step)  # no tunnelling, Galilean invariance, detection cost (~5 minutes)
+      run fig4_rpy_end_of_step $bin/fig4_spheres --mobility rpy --end-of-step
+      run fig4_rpy_whole_step $bin/fig4_spheres --mobility rpy
+      run fig4_rpy_whole_step_relative $bin/fig4_spheres --mobility rpy --d-try-rule relative
+      run continuous_detection $bin/continuous_detection ;;
     *) echo "unknown part $part" >&2; exit 2 ;;
   esac
 done

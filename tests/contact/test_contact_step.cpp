@@ -96,8 +96,9 @@ struct SphereScene {
   sc::FreeDrainingMobility mobility() const {
     return sc::FreeDrainingMobility(sc::sphere_mobility(shapes[0], 1.0), poses.size(), 3);
   }
+  // The paper's d_try (eq. 31), which the closed forms and counts below assume.
   sc::ContactStepProblem<sc::Sphere> problem() const {
-    return {shapes, poses, U, dt, d_hat, d_try, 1.0, {}};
+    return {shapes, poses, U, dt, d_hat, d_try, 1.0, {}, sc::DTryRule::absolute};
   }
 };
 

@@ -23,6 +23,8 @@ TEST(DiagnosticsJson, EveryFieldInItsPlace) {
   d.time = 0.25;
   d.flagged_pairs = 7;
   d.active_pairs = 3;
+  d.carried_pairs = 1;
+  d.substeps = 2;
   d.min_distance_ratio = 1.0001;
   d.status = sc::ContactStepStatus::not_converged;
   d.message = "stopped after 50 corrections";
@@ -33,7 +35,8 @@ TEST(DiagnosticsJson, EveryFieldInItsPlace) {
   d.lambda_sum = 12.5;
   d.lambda_max = 4.0;
   EXPECT_EQ(sc::to_json(d),
-            R"({"step": 12, "time": 0.25, "flagged_pairs": 7, "active_pairs": 3, "min_distance_ratio": 1.0001, )"
+            R"({"step": 12, "time": 0.25, "flagged_pairs": 7, "active_pairs": 3, "carried_pairs": 1, "substeps": 2, )"
+            R"("min_distance_ratio": 1.0001, )"
             R"("status": "not_converged", "message": "stopped after 50 corrections", "iterations": 50, )"
             R"("unconstrained_applications": 1, "mobility_applications": 9, "wall_time_s": 0.5, )"
             R"("lambda_sum": 12.5, "lambda_max": 4})");

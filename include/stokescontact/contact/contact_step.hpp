@@ -4,7 +4,8 @@
 //
 // Given a contact-free configuration Q_t and the unconstrained velocities U (the caller's
 // mobility solve, not counted here), the trial step Q* = Q_t + dt Psi U (eq. 16) flags the
-// Nc pairs with d^P <= d_try (eq. 30/31) and builds the contact matrix D at Q*: from the
+// Nc pairs with d^P <= d_try (by default one threshold per pair from its relative motion,
+// contact/continuous_detection.hpp; eq. 30/31 on request) and builds the contact matrix D at Q*: from the
 // closest points (d^P, eq. 20-21) or from the surface-node pairs within d_try (d^S, eq.
 // 22-23; by default for boomerangs, whose non-convex contacts may touch at several places).
 // The constraint is on d^P in both cases (d^S >= d^P for every node pair, Sec. 3.2.1, which
@@ -19,10 +20,27 @@
 //   matrix_free: one application per distinct M D lambda and per D^T M v.
 // lambda = 0 costs nothing in both modes, so a step without contacts costs 0 applications.
 //
-// The guarantee (run_contact_step): after a solve, every pair of the new configuration is
-// checked; a pair that was not flagged and now has d < d_hat (1 - separation_margin) is
-// added (its column from its closest points at Q*) and the step re-solved, warm-started. A
-// step that still violates d_hat reports failed_separation with the numbers, never silently.
+// Pairs that pass through each other (or sweep past) in the trial step. A flagged pair whose
+// distance along the trial motion has its minimum inside the step, below min(d*, d_hat), ends
+// on the wrong side (or elsewhere) at Q*, so its closest points there point the wrong way.
+// Such a pair is constrained where it first comes within d_hat, at t_c: its contact is the
+// pair of centre-curve points closest at Q(t_c), carried with the bodies (material points),
+// with the normal n_c of that moment held fixed, and its distance at a configuration is the
+// gap of those points along n_c less the radii (< 0 once they have passed each other). Its
+// column of D is the gradient of that gap at Q*, consistent with the distance.
+//
+// The guarantee (run_contact_step) covers the whole step. After a solve:
+//   end:      every pair of Q(lambda) has d >= d_hat (1 - separation_margin); a pair that was
+//             not flagged and is closer is added (its column from its closest points at Q*);
+//   interior: along the corrected motion Q_t + t' Psi (U + M D lambda), t' in [0, dt], no
+//             pair overlaps: d(t') >= -separation_margin d_hat (conservative advancement,
+//             exact for spheres). A pair that does is added as a carried contact, from where
+//             it first comes within d_hat on the corrected motion.
+// The interior bound is no overlap, not d_hat: d_hat is the margin the next step's
+// linearisation needs at its start, while inside a step only overlap is unphysical; a
+// rotating body held at d_hat at the end may come closer inside without touching. The step
+// is then re-solved, warm-started. One that still violates either reports failed_separation
+// with the numbers, never silently (the time stepper then sub-steps by default).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -42,6 +60,7 @@
 #include "stokescontact/contact/barrier.hpp"
 #include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/contact/contact_pairs.hpp"
+#include "stokescontact/contact/continuous_detection.hpp"
 #include "stokescontact/contact/d_try.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
@@ -61,6 +80,7 @@ struct ContactStepProblem {
                                      // > 0: used as given (>= d_hat), the multiplier ignored
   double d_try_multiplier = 1.0;     // >= 1
   std::optional<PeriodicBox> box = std::nullopt;  // periodic box, none for open space
+  DTryRule d_try_rule = DTryRule::relative;        // when d_try = 0: per pair (relative) or eq. 30/31
 };
 
 enum class MobilityCost { formed, matrix_free };
@@ -76,6 +96,9 @@ struct ContactStepOptions {
   // Re-solves after adding pairs the trial step missed (the guarantee loop).
   int max_guarantee_rounds = 3;
   ContactDirections directions = ContactDirections::automatic;
+  // The guarantee over the whole step (carried contacts, the interior check); false: the
+  // paper's check at the end of the step only, where bodies may pass through each other.
+  bool whole_step = true;
   // Surface-node spacing h for eq. 23; 0: half the shape's radius.
   double node_spacing = 0.0;
   SurfaceWeights surface_weights;
@@ -129,6 +152,7 @@ struct ContactStepResult {
   double lambda_sum = 0.0;
   double lambda_max = 0.0;
   std::size_t flagged_pairs = 0;        // Nc
+  std::size_t carried_pairs = 0;        // of them, constrained where they first came within d_hat
   int guarantee_rounds = 0;             // re-solves after adding missed pairs
 };
 
@@ -139,6 +163,35 @@ struct ContactSolveOutcome {
   bool converged = false;
   std::string message;
 };
+
+// A pair constrained where it first came within d_hat (see the top of this file): its
+// centre-curve points in each body's frame (body j: its image), carried with the bodies,
+// and the normal of that moment, fixed.
+struct CarriedContact {
+  Vec3 curve_point_i = Vec3::Zero();
+  Vec3 curve_point_j = Vec3::Zero();
+  Vec3 normal = Vec3::UnitX();
+  double radius_i = 0.0;
+  double radius_j = 0.0;
+  double time = 0.0;  // t_c in [0, dt]
+};
+
+// The carried contact of bodies i, j (image shift) at a configuration: points, fixed normal
+// and their gap along it, d = n . (c_j - c_i) - r_i - r_j.
+inline ContactPair carried_pair(const CarriedContact& c, Eigen::Index i, Eigen::Index j, const Vec3& image_shift,
+                                std::span<const Pose> poses) {
+  const Vec3 ci = poses[static_cast<std::size_t>(i)].to_world(c.curve_point_i);
+  const Vec3 cj = shifted(poses[static_cast<std::size_t>(j)], image_shift).to_world(c.curve_point_j);
+  ContactPair p{i, j, image_shift, {}};
+  p.points.distance = c.normal.dot(cj - ci) - c.radius_i - c.radius_j;
+  p.points.normal = c.normal;
+  p.points.curve_point_a = ci;
+  p.points.curve_point_b = cj;
+  // Both forces at the middle of the carried points: torques balance (at the contact time the
+  // points lie along the normal and this is the gap's exact gradient).
+  p.points.point_a = p.points.point_b = 0.5 * (ci + cj);
+  return p;
+}
 
 // Q(lambda) with its flagged-pair distances and closest points.
 struct ContactEvaluation {
@@ -170,16 +223,15 @@ class ContactStep {
       fail_argument("mobility", "has size " + std::to_string(mobility.size()) + ", expected " +
                                     std::to_string(problem.poses.size() * static_cast<std::size_t>(dofs_)));
     if (problem.box) require_finite(problem.box->lengths, "box.lengths");
+    require_finite(problem.d_try_multiplier, "d_try_multiplier");
+    if (!(problem.d_try_multiplier >= 1.0))
+      fail_argument("d_try_multiplier", "must be >= 1, got " + std::to_string(problem.d_try_multiplier));
     const MinimumDistance start = minimum_pair_distance(problem.shapes, problem.poses, problem.box);
     if (start.distance < 0.0)
       fail_argument("poses", "Q_t must be contact free; bodies " + std::to_string(start.i) + " and " +
                                  std::to_string(start.j) + " overlap, d = " + std::to_string(start.distance));
     d_try_ = problem.d_try;
-    if (d_try_ == 0.0) {
-      d_try_ = dofs_ == 3 ? d_try_spheres(problem.d_hat, problem.dt, problem.U, 3, problem.d_try_multiplier)
-                          : d_try_tip_velocity(problem.d_hat, problem.dt, problem.shapes, problem.poses, problem.U,
-                                               problem.d_try_multiplier);
-    } else {
+    if (d_try_ != 0.0) {
       require_positive(d_try_, "d_try");
       if (!(d_try_ >= problem.d_hat))
         fail_argument("d_try", "must be >= d_hat = " + std::to_string(problem.d_hat) + ", got " +
@@ -190,7 +242,24 @@ class ContactStep {
         nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : 0.5 * shape.radius));
     }
     trial_ = advance_all(problem.poses, problem.U, dofs_, problem.dt);  // Q*, eq. 16
-    pairs_ = find_contact_pairs(problem.shapes, std::span<const Pose>(trial_), d_try_, problem.box);
+    const std::span<const Pose> trial(trial_);
+    if (d_try_ == 0.0 && problem.d_try_rule == DTryRule::relative) {
+      RelativePairs found = find_pairs_relative(problem.shapes, trial, problem.U, dofs_, problem.dt, problem.d_hat,
+                                                problem.d_try_multiplier, problem.box);
+      pairs_ = std::move(found.pairs);
+      // One value where one is needed (the barrier's eps_reg, the d^S node threshold): the largest.
+      d_try_ = problem.d_try_multiplier * problem.d_hat;
+      for (double d : found.d_try) d_try_ = std::max(d_try_, d);
+    } else {
+      if (d_try_ == 0.0)
+        d_try_ = dofs_ == 3 ? d_try_spheres(problem.d_hat, problem.dt, problem.U, 3, problem.d_try_multiplier)
+                            : d_try_tip_velocity(problem.d_hat, problem.dt, problem.shapes, problem.poses, problem.U,
+                                                 problem.d_try_multiplier);
+      pairs_ = find_contact_pairs(problem.shapes, trial, d_try_, problem.box);
+    }
+    carried_.assign(pairs_.size(), std::nullopt);
+    if (options.whole_step)
+      for (std::size_t k = 0; k < pairs_.size(); ++k) carry_if_passing(k);
     rebuild();
     // Everything checked: only now touch the mobility.
     start_applications_ = mobility.applications();
@@ -200,11 +269,31 @@ class ContactStep {
   // Adds pairs (i < j) not yet flagged, measured at Q*; returns how many were new.
   std::size_t add_pairs(std::span<const ContactPair> found) {
     std::set<std::pair<Eigen::Index, Eigen::Index>> known;
-    for (const ContactPair& p : pairs_) known.insert({p.i, p.j});
+    for (std::size_t k = 0; k < pairs_.size(); ++k)
+      if (!carried_[k]) known.insert({pairs_[k].i, pairs_[k].j});
     std::size_t added = 0;
     for (const ContactPair& p : found)
       if (known.insert({p.i, p.j}).second) {
         pairs_.push_back(detail::contact_pair(problem_.shapes, std::span<const Pose>(trial_), p.i, p.j, problem_.box));
+        carried_.emplace_back();
+        ++added;
+      }
+    if (added > 0) rebuild();
+    return added;
+  }
+
+  // Adds carried contacts for pairs that overlap inside the step on the motion with
+  // velocities V, from where each first comes within d_hat on it; a pair that already has
+  // one is not added again. Returns how many were new.
+  std::size_t add_crossings(std::span<const TrajectoryCrossing> found, const VecX& V) {
+    std::set<std::pair<Eigen::Index, Eigen::Index>> known;
+    for (std::size_t k = 0; k < pairs_.size(); ++k)
+      if (carried_[k]) known.insert({pairs_[k].i, pairs_[k].j});
+    std::size_t added = 0;
+    for (const TrajectoryCrossing& c : found)
+      if (known.insert({c.i, c.j}).second) {
+        carried_.push_back(first_approach(c.i, c.j, c.image_shift, V));
+        pairs_.push_back(carried_pair(*carried_.back(), c.i, c.j, c.image_shift, std::span<const Pose>(trial_)));
         ++added;
       }
     if (added > 0) rebuild();
@@ -243,8 +332,11 @@ class ContactStep {
     e.pairs.reserve(pairs_.size());
     e.distances.resize(nc());
     for (std::size_t k = 0; k < pairs_.size(); ++k) {
-      e.pairs.push_back(
-          detail::contact_pair(problem_.shapes, std::span<const Pose>(e.poses), pairs_[k].i, pairs_[k].j, problem_.box));
+      const ContactPair& p = pairs_[k];
+      e.pairs.push_back(carried_[k]
+                            ? carried_pair(*carried_[k], p.i, p.j, p.image_shift, std::span<const Pose>(e.poses))
+                            : detail::contact_pair(problem_.shapes, std::span<const Pose>(e.poses), p.i, p.j,
+                                                   problem_.box));
       e.distances(static_cast<Eigen::Index>(k)) = e.pairs.back().points.distance;
     }
     last_ = std::move(e);
@@ -264,6 +356,10 @@ class ContactStep {
   bool all_separated(const ContactEvaluation& e) const { return nc() == 0 || separated(e.min_distance()); }
 
   Eigen::Index nc() const { return static_cast<Eigen::Index>(pairs_.size()); }
+  std::size_t carried_count() const {
+    return static_cast<std::size_t>(std::count_if(carried_.begin(), carried_.end(), [](const auto& c) { return c.has_value(); }));
+  }
+  int dofs_per_body() const { return dofs_; }
   const Eigen::SparseMatrix<double>& D() const { return D_; }
   const std::vector<ContactPair>& pairs() const { return pairs_; }
   const ContactStepProblem<S>& problem() const { return problem_; }
@@ -273,24 +369,64 @@ class ContactStep {
 
  private:
   // Pairs are only ever appended: columns of M D already formed stay valid.
+  // A carried contact's column: its gap's gradient, in both modes (particle_contact_column
+  // on its carried pair, whose two forces act at one point, the middle of the carried
+  // points, so that the column keeps Newton's third law for torques too).
   void rebuild() {
     last_.reset();
     const std::span<const Pose> trial(trial_);
-    if (nodes_.empty()) {
-      D_ = contact_matrix(std::span<const ContactPair>(pairs_), trial, dofs_);
-      return;
-    }
-    std::vector<SurfaceContact> contacts;
-    contacts.reserve(pairs_.size());
-    for (const ContactPair& p : pairs_) {
+    std::optional<BarrierParameters> weight_barrier;
+    if (!nodes_.empty()) weight_barrier = detail::surface_weight_barrier(d_try_, options_.surface_weights);
+    std::vector<ContactColumn> columns;
+    columns.reserve(pairs_.size());
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+      const ContactPair& p = pairs_[k];
+      const std::string field = "pairs[" + std::to_string(k) + "]";
+      if (!weight_barrier || carried_[k]) {
+        columns.push_back(detail::particle_contact_column(p, trial, field));
+        continue;
+      }
       const auto i = static_cast<std::size_t>(p.i), j = static_cast<std::size_t>(p.j);
-      contacts.push_back({p.i, p.j, p.image_shift,
-                          surface_distances(shape_of(problem_.shapes, i), trial_[i], nodes_of(i),
-                                            shape_of(problem_.shapes, j), shifted(trial_[j], p.image_shift),
-                                            nodes_of(j), d_try_)});
+      const SurfaceContact contact{p.i, p.j, p.image_shift,
+                                   surface_distances(shape_of(problem_.shapes, i), trial_[i], nodes_of(i),
+                                                     shape_of(problem_.shapes, j), shifted(trial_[j], p.image_shift),
+                                                     nodes_of(j), d_try_)};
+      columns.push_back(
+          detail::surface_contact_column(contact, trial, *weight_barrier, options_.surface_weights, field));
     }
-    D_ = surface_contact_matrix(std::span<const SurfaceContact>(contacts), trial, d_try_, dofs_,
-                                options_.surface_weights);
+    D_ = assemble_contact_matrix(columns, trial_.size(), dofs_);
+  }
+
+  // Flagged pair k passes through or sweeps past in the trial step when its distance along
+  // the trial motion has a minimum inside the step below min(d*, d_hat) (by a tenth of d_hat,
+  // so rounding and the search tolerance decide nothing): it is then carried.
+  void carry_if_passing(std::size_t k) {
+    const ContactPair& p = pairs_[k];
+    const auto i = static_cast<std::size_t>(p.i), j = static_cast<std::size_t>(p.j);
+    const double margin = 0.1 * problem_.d_hat;
+    const RigidVelocity vi = rigid_velocity(problem_.U, i, dofs_), vj = rigid_velocity(problem_.U, j, dofs_);
+    const SweptDistance lowest =
+        swept_minimum(shape_of(problem_.shapes, i), problem_.poses[i], vi, shape_of(problem_.shapes, j),
+                      shifted(problem_.poses[j], p.image_shift), vj, problem_.dt, 0.5 * margin);
+    if (!(lowest.points.distance < std::min(p.points.distance, problem_.d_hat) - margin)) return;
+    carried_[k] = first_approach(p.i, p.j, p.image_shift, problem_.U);
+    pairs_[k] = carried_pair(*carried_[k], p.i, p.j, p.image_shift, std::span<const Pose>(trial_));
+  }
+
+  // The carried contact of a pair from where it first comes within d_hat on the motion with
+  // velocities V (at t = 0 if it starts there).
+  CarriedContact first_approach(Eigen::Index i, Eigen::Index j, const Vec3& image_shift, const VecX& V) const {
+    const auto si = static_cast<std::size_t>(i), sj = static_cast<std::size_t>(j);
+    const S& shape_i = shape_of(problem_.shapes, si);
+    const S& shape_j = shape_of(problem_.shapes, sj);
+    const RigidVelocity vi = rigid_velocity(V, si, dofs_), vj = rigid_velocity(V, sj, dofs_);
+    const Pose start_j = shifted(problem_.poses[sj], image_shift);
+    const SweptDistance first = first_time_below(shape_i, problem_.poses[si], vi, shape_j, start_j, vj, problem_.dt,
+                                                 problem_.d_hat, 1e-3 * problem_.d_hat);
+    const Pose at_i = advance(problem_.poses[si], vi.u, vi.omega, first.time);
+    const Pose at_j = advance(start_j, vj.u, vj.omega, first.time);
+    return {at_i.to_body(first.points.curve_point_a), at_j.to_body(first.points.curve_point_b), first.points.normal,
+            shape_i.radius, shape_j.radius, first.time};
   }
 
   const SurfaceNodes& nodes_of(std::size_t body) const { return nodes_.size() == 1 ? nodes_[0] : nodes_[body]; }
@@ -310,7 +446,8 @@ class ContactStep {
   double d_try_ = 0.0;
   std::size_t start_applications_ = 0;
   std::vector<Pose> trial_;  // Q*
-  std::vector<ContactPair> pairs_;
+  std::vector<ContactPair> pairs_;                    // carried ones: their carried pair at Q*
+  std::vector<std::optional<CarriedContact>> carried_;  // per pair: carried or not
   std::vector<SurfaceNodes> nodes_;  // per shape, for d^S directions (empty: d^P)
   Eigen::SparseMatrix<double> D_;
   std::vector<VecX> MD_columns_;  // the columns of M D formed so far (empty: not yet)
@@ -347,22 +484,39 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   ContactStepResult r;
   ContactSolveOutcome outcome;
   std::vector<ContactPair> violating;
+  std::vector<TrajectoryCrossing> crossing;
+  const double overlap_tolerance = std::max(0.5 * options.separation_margin, 1e-6) * problem.d_hat;
   for (int round = 0;; ++round) {
     const int iterations = r.iterations;
     outcome = solve(step, detail::padded(outcome.lambda, step.nc()));
     r.iterations = iterations + outcome.iterations;
     r.guarantee_rounds = round;
     const ContactEvaluation& e = step.evaluate(outcome.lambda);
-    // The check over all pairs, not only the flagged ones.
+    // The end: all pairs, not only the flagged ones.
     violating = find_contact_pairs(problem.shapes, std::span<const Pose>(e.poses),
                                    problem.d_hat * (1.0 - options.separation_margin), problem.box);
     std::erase_if(violating, [&](const ContactPair& p) { return step.separated(p.points.distance); });
-    if (violating.empty() || round == options.max_guarantee_rounds || step.add_pairs(violating) == 0) break;
+    // The interior: no overlap along the corrected motion.
+    const VecX V = problem.U + e.MD_lambda;
+    if (options.whole_step)
+      crossing = trajectory_crossings(problem.shapes, problem.poses, V, step.dofs_per_body(), problem.dt,
+                                      -options.separation_margin * problem.d_hat, overlap_tolerance, problem.box);
+    if ((violating.empty() && crossing.empty()) || round == options.max_guarantee_rounds) break;
+    // A pair too close at the end is held there by its end constraint; carried contacts are
+    // for pairs that overlap inside the step only, or whose end constraint let them.
+    std::vector<TrajectoryCrossing> inside = crossing;
+    std::erase_if(inside, [&](const TrajectoryCrossing& c) {
+      return std::any_of(violating.begin(), violating.end(),
+                         [&](const ContactPair& p) { return p.i == c.i && p.j == c.j; });
+    });
+    const std::size_t added = step.add_pairs(violating) + step.add_crossings(inside, V);
+    if (added == 0) break;
   }
   const ContactEvaluation& e = step.evaluate(outcome.lambda);
   r.lambda = outcome.lambda;
   r.pairs = step.pairs();
   r.flagged_pairs = r.pairs.size();
+  r.carried_pairs = step.carried_count();
   r.contact_forces = step.D() * r.lambda;
   r.velocities = problem.U + e.MD_lambda;
   r.poses = e.poses;
@@ -375,12 +529,18 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   r.lambda_sum = r.lambda.sum();
   r.lambda_max = r.lambda.size() == 0 ? 0.0 : r.lambda.maxCoeff();
   r.mobility_applications = step.applications();
-  if (!violating.empty()) {
+  if (!violating.empty() || !crossing.empty()) {
     std::ostringstream os;
-    os << "failed separation: " << violating.size() << " pair(s) below d_hat (1 - " << options.separation_margin
-       << ") after " << r.guarantee_rounds << " guarantee round(s); min d / d_hat = " << r.min_distance_ratio
-       << " (bodies " << violating.front().i << ", " << violating.front().j << ")";
-    if (!outcome.message.empty()) os << "; solver: " << outcome.message;
+    os << "failed separation after " << r.guarantee_rounds << " guarantee round(s):";
+    if (!violating.empty())
+      os << " " << violating.size() << " pair(s) below d_hat (1 - " << options.separation_margin
+         << ") at the end, min d / d_hat = " << r.min_distance_ratio << " (bodies " << violating.front().i << ", "
+         << violating.front().j << ");";
+    if (!crossing.empty())
+      os << " " << crossing.size() << " pair(s) overlap inside the step, first bodies " << crossing.front().i
+         << ", " << crossing.front().j << " at t'/dt = " << crossing.front().first.time / problem.dt
+         << " with d / d_hat = " << crossing.front().first.points.distance / problem.d_hat << ";";
+    if (!outcome.message.empty()) os << " solver: " << outcome.message;
     r.status = ContactStepStatus::failed_separation;
     r.message = os.str();
   } else {

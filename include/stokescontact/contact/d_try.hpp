@@ -7,6 +7,13 @@
 // Both are scaled as a whole by a user multiplier >= 1 (the paper's robustness test, Sec.
 // 3.1.2, uses 1, 1.1 and 1.2).
 //
+// Those two rules take absolute speeds, so a suspension carried by a uniform flow, or
+// sheared about a far-away plane, flags more pairs the faster it moves. The library's
+// default rule is relative (DTryRule::relative, contact/continuous_detection.hpp): one
+// threshold per pair from the pair's own relative motion, d_try_ij = m (d_hat + dt L_ij) with
+// L_ij the bound on the rate of change of its distance (geometry/swept_distance.hpp); a
+// pair whose distance falls below d_hat anywhere in the trial step is then always flagged.
+//
 // Our eq. 30 takes the fastest point of each body's centre curve, not one tip: a distance
 // is the centre-curve distance less the (rotation-invariant) radii, so no distance changes
 // faster than the sum of the two bodies' fastest centre-curve points. For a rod this is the
@@ -23,6 +30,12 @@
 #include "stokescontact/contact/scene.hpp"
 
 namespace stokescontact {
+
+// How the contact step chooses d_try when it is not given.
+//   relative: per pair, m (d_hat + dt L_ij), L_ij from the pair's relative motion (Galilean
+//             invariant; catches every pair that comes within d_hat during the trial step);
+//   absolute: the paper's single threshold, eq. 31 (3 dofs) or eq. 30 (6 dofs).
+enum class DTryRule { relative, absolute };
 
 namespace detail {
 

@@ -11,8 +11,12 @@ namespace stokescontact {
 struct StepDiagnostics {
   long step = 0;                       // 1 for the first step
   double time = 0.0;                   // t + dt, the time reached
-  std::size_t flagged_pairs = 0;       // Nc at the trial step (and pairs the guarantee loop added)
+  std::size_t flagged_pairs = 0;       // Nc at the trial step (and pairs the guarantee loop added);
+                                       // pair counts are the largest over sub-steps, work adds up
   std::size_t active_pairs = 0;        // pairs with lambda > 0
+  std::size_t carried_pairs = 0;       // flagged pairs constrained where they first came within d_hat
+                                       // (they passed or swept past each other in the trial step)
+  std::size_t substeps = 1;            // contact steps the step took (> 1: it was sub-stepped)
   double min_distance_ratio = 0.0;     // min d^P over all pairs of Q_{t+dt} / d_hat (inf: < 2 bodies)
   ContactStepStatus status = ContactStepStatus::converged;
   std::string message;                 // the solver's message (empty when it has nothing to say)

@@ -12,12 +12,18 @@
 // A background flow with a periodic box is refused: u = E x is not periodic, and
 // Lees-Edwards boundary conditions are not implemented.
 //
-// Failures are not hidden: a contact step that reports failed_separation makes step() throw
-// std::runtime_error with the solver's message, and the state stays at Q_t. Bad input throws
-// std::invalid_argument naming the field before anything changes.
+// Sub-stepping: a contact step that reports failed_separation (a pair below d_hat at the end,
+// or overlapping inside the step, that the solver could not hold) is retried as two steps of
+// dt/2, each from its own start with its own U (steps 1-2), recursively up to
+// max_substep_halvings times (2^k sub-steps of dt/2^k). The step is committed only when every
+// sub-step succeeded; its diagnostics add up their work (substeps says how many).
+// Failures are not hidden: a step that still fails makes step() throw std::runtime_error with
+// the solver's message, and the state stays at Q_t. Bad input throws std::invalid_argument
+// naming the field before anything changes.
 #include <chrono>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -36,8 +42,10 @@ namespace stokescontact {
 struct TimeStepperOptions {
   double dt = 0.0;                   // > 0
   double d_hat = 0.0;                // > 0
-  double d_try = 0.0;                // 0: eq. 30/31 per step (ContactStepProblem.d_try)
+  double d_try = 0.0;                // 0: per step by d_try_rule (ContactStepProblem.d_try)
   double d_try_multiplier = 1.0;     // >= 1
+  DTryRule d_try_rule = DTryRule::relative;  // when d_try = 0 (ContactStepProblem.d_try_rule)
+  int max_substep_halvings = 4;      // in [0, 30]; 0: a failed step throws at once
   std::optional<PeriodicBox> box;    // none for open space
   std::optional<LinearBackgroundFlow> background_flow;  // none: fluid at rest
   ContactStepOptions contact_step;   // given to the contact solver at every step
@@ -52,6 +60,8 @@ struct TimeStepperOptions {
     require_finite(d_try_multiplier, "d_try_multiplier");
     if (!(d_try_multiplier >= 1.0))
       fail_argument("d_try_multiplier", "must be >= 1, got " + std::to_string(d_try_multiplier));
+    if (max_substep_halvings < 0 || max_substep_halvings > 30)
+      fail_argument("max_substep_halvings", "must lie in [0, 30], got " + std::to_string(max_substep_halvings));
     if (box) {
       for (int k = 0; k < 3; ++k) require_positive(box->lengths[k], "box.lengths");
       if (background_flow && !background_flow->is_zero())
@@ -127,51 +137,21 @@ class TimeStepper {
   // on failed separation.
   StepDiagnostics step() {
     const auto start = std::chrono::steady_clock::now();
-    const std::span<const Pose> q_t(poses_);
-    // Eq. 3: U = U_bg + M F_ext.
-    std::optional<VecX> forces;
-    if (force_field_) {
-      VecX f = force_field_(time_, q_t);
-      require_finite(f, size(), "external_forces");
-      forces = std::move(f);
-    } else if (forces_) {
-      forces = *forces_;
-    }
-    VecX U = options_.background_flow ? options_.background_flow->body_velocities(q_t, dofs_) : VecX::Zero(size());
-    std::size_t applications = 0;
-    if (forces && !forces->isZero(0.0)) {
-      mobility_.set_configuration(q_t);
-      U += mobility_.apply(*forces);
-      applications = 1;
-    }
-    // Eq. 13/16 through the chosen solver.
-    const ContactStepProblem<S> problem{std::span<const S>(shapes_), q_t, U, options_.dt, options_.d_hat,
-                                        options_.d_try,              options_.d_try_multiplier, options_.box};
-    ContactStepResult result = solve(problem);
-    if (result.status == ContactStepStatus::failed_separation)
+    std::vector<Pose> poses = poses_;
+    StepDiagnostics d;
+    d.substeps = 0;
+    d.min_distance_ratio = std::numeric_limits<double>::infinity();
+    std::string failure;
+    if (!advance_interval(poses, time_, options_.dt, 0, d, failure))
       throw std::runtime_error("time step " + std::to_string(steps_ + 1) + " from t = " + std::to_string(time_) +
-                               ": " + result.message);
-    if (result.poses.size() != poses_.size())
-      throw std::runtime_error("contact solver returned " + std::to_string(result.poses.size()) + " poses for " +
-                               std::to_string(poses_.size()) + " bodies");
+                               ": " + failure);
     // Commit Q_{t+dt}.
-    poses_ = std::move(result.poses);
+    poses_ = std::move(poses);
     wrap_into_box();
     ++steps_;
     time_ = t0_plus_steps();
-    StepDiagnostics d;
     d.step = steps_;
     d.time = time_;
-    d.flagged_pairs = result.flagged_pairs;
-    for (Eigen::Index k = 0; k < result.lambda.size(); ++k) d.active_pairs += result.lambda(k) > 0.0 ? 1 : 0;
-    d.min_distance_ratio = result.min_distance_ratio;  // minimum image in a box: wrapping changes nothing
-    d.status = result.status;
-    d.message = std::move(result.message);
-    d.iterations = result.iterations;
-    d.unconstrained_applications = applications;
-    d.mobility_applications = applications + result.mobility_applications;
-    d.lambda_sum = result.lambda_sum;
-    d.lambda_max = result.lambda_max;
     d.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     diagnostics_.push_back(std::move(d));
     for (const StepObserver& observer : observers_) observer(diagnostics_.back(), std::span<const Pose>(poses_));
@@ -213,6 +193,59 @@ class TimeStepper {
       fail_argument("poses", "Q_0 must be contact free; bodies " + std::to_string(closest.i) + " and " +
                                  std::to_string(closest.j) + " overlap, d = " + std::to_string(closest.distance));
     wrap_into_box();
+  }
+
+  // Steps 1-2 over [t, t + h] from `poses`, advanced in place; on failed separation, two
+  // halves, down to max_substep_halvings. False (with the last message) if that fails too.
+  bool advance_interval(std::vector<Pose>& poses, double t, double h, int halvings, StepDiagnostics& d,
+                        std::string& failure) {
+    const std::span<const Pose> q_t(poses);
+    // Eq. 3: U = U_bg + M F_ext.
+    std::optional<VecX> forces;
+    if (force_field_) {
+      VecX f = force_field_(t, q_t);
+      require_finite(f, size(), "external_forces");
+      forces = std::move(f);
+    } else if (forces_) {
+      forces = *forces_;
+    }
+    VecX U = options_.background_flow ? options_.background_flow->body_velocities(q_t, dofs_) : VecX::Zero(size());
+    std::size_t applications = 0;
+    if (forces && !forces->isZero(0.0)) {
+      mobility_.set_configuration(q_t);
+      U += mobility_.apply(*forces);
+      applications = 1;
+    }
+    // Eq. 13/16 through the chosen solver.
+    ContactStepProblem<S> problem{std::span<const S>(shapes_), q_t, U, h, options_.d_hat,
+                                  options_.d_try,              options_.d_try_multiplier, options_.box};
+    problem.d_try_rule = options_.d_try_rule;
+    ContactStepResult result = solve(problem);
+    d.unconstrained_applications += applications;
+    d.mobility_applications += applications + result.mobility_applications;
+    d.iterations += result.iterations;
+    if (result.status == ContactStepStatus::failed_separation) {
+      failure = result.message;
+      if (halvings >= options_.max_substep_halvings) return false;
+      return advance_interval(poses, t, 0.5 * h, halvings + 1, d, failure) &&
+             advance_interval(poses, t + 0.5 * h, 0.5 * h, halvings + 1, d, failure);
+    }
+    if (result.poses.size() != poses.size())
+      throw std::runtime_error("contact solver returned " + std::to_string(result.poses.size()) + " poses for " +
+                               std::to_string(poses.size()) + " bodies");
+    poses = std::move(result.poses);
+    ++d.substeps;
+    d.flagged_pairs = std::max(d.flagged_pairs, result.flagged_pairs);
+    std::size_t active = 0;
+    for (Eigen::Index k = 0; k < result.lambda.size(); ++k) active += result.lambda(k) > 0.0 ? 1 : 0;
+    d.active_pairs = std::max(d.active_pairs, active);
+    d.carried_pairs = std::max(d.carried_pairs, result.carried_pairs);
+    d.min_distance_ratio = std::min(d.min_distance_ratio, result.min_distance_ratio);  // minimum image in a box
+    if (result.status == ContactStepStatus::not_converged || d.substeps == 1) d.status = result.status;
+    if (!result.message.empty()) d.message = std::move(result.message);
+    d.lambda_sum += result.lambda_sum;
+    d.lambda_max = std::max(d.lambda_max, result.lambda_max);
+    return true;
   }
 
   ContactStepResult solve(const ContactStepProblem<S>& problem) {

@@ -16,6 +16,8 @@ inline std::string to_json(const StepDiagnostics& d) {
   return "{\"step\": " + std::to_string(d.step) + ", \"time\": " + json_number(d.time) +
          ", \"flagged_pairs\": " + std::to_string(d.flagged_pairs) +
          ", \"active_pairs\": " + std::to_string(d.active_pairs) +
+         ", \"carried_pairs\": " + std::to_string(d.carried_pairs) +
+         ", \"substeps\": " + std::to_string(d.substeps) +
          ", \"min_distance_ratio\": " + json_number(d.min_distance_ratio) +
          ", \"status\": " + json_quoted(to_string(d.status)) + ", \"message\": " + json_quoted(d.message) +
          ", \"iterations\": " + std::to_string(d.iterations) +

@@ -1,0 +1,180 @@
+#pragma once
+// Contact detection over the whole step, not only at its end, and from relative motion only.
+//
+// Each body moves over the step with its constant rigid velocity (u, omega): Q(t') = Q_t +
+// t' Psi U, t' in [0, dt] (Broms & Tornberg eq. 13/16). geometry/swept_distance.hpp bounds the
+// rate of change of a pair's distance by L_ij = |u_i - u_j| + |omega_i| rho_i + |omega_j| rho_j.
+//
+// find_pairs_relative (DTryRule::relative): the trial step's flagged pairs with one threshold
+// per pair, d_try_ij = m (d_hat + dt L_ij). Since d(dt) <= d(t') + (dt - t') L_ij, a pair that
+// comes within d_hat at any t' of the trial step has d* <= d_try_ij: it is flagged even when
+// its end state is separated (it passed through, or swept past). The broad phase works in
+// the frame moving with the mean velocity, where body i's reach grows by m dt (|u_i - u_mean|
+// + |omega_i| rho_i); a common velocity added to every body changes neither the flagged set
+// nor the candidates (to rounding), unlike eq. 30/31.
+//
+// trajectory_crossings: every pair whose distance along a given motion drops to a threshold
+// at some t' in [0, dt], with the first such time (conservative advancement; exact for
+// spheres). Its broad phase tests, in the mean-velocity frame, the balls that hold each
+// body's bounding ball over the step: centre x_i + (dt/2)(u_i - u_mean), radius r_i +
+// (dt/2)|u_i - u_mean| (a bounding ball about the centre does not move under rotation).
+//
+// Both broad phases keep a few fast bodies from coarsening the cell list for all: a body
+// whose grown ball is more than twice the largest bounding radius is tested against every
+// body (detail::swept_candidates).
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "stokescontact/contact/contact_pairs.hpp"
+#include "stokescontact/contact/d_try.hpp"
+#include "stokescontact/geometry/swept_distance.hpp"
+
+namespace stokescontact {
+
+// Body k's velocity from U stacked per body as (u) or (u, omega), dofs_per_body 3 or 6.
+inline RigidVelocity rigid_velocity(const VecX& U, std::size_t body, int dofs_per_body) {
+  const Eigen::Index row = static_cast<Eigen::Index>(body) * dofs_per_body;
+  return {U.segment<3>(row), dofs_per_body == 6 ? Vec3(U.segment<3>(row + 3)) : Vec3::Zero()};
+}
+
+// The flagged pairs at Q* with their own thresholds d_try_ij.
+struct RelativePairs {
+  std::vector<ContactPair> pairs;  // measured at Q*, sorted by (i, j)
+  std::vector<double> d_try;       // one per pair
+};
+
+namespace detail {
+
+inline Vec3 mean_velocity(const VecX& U, std::size_t bodies, int dofs_per_body) {
+  Vec3 sum = Vec3::Zero();
+  for (std::size_t k = 0; k < bodies; ++k) sum += rigid_velocity(U, k, dofs_per_body).u;
+  return bodies == 0 ? sum : Vec3(sum / static_cast<double>(bodies));
+}
+
+// Candidate pairs (i < j, sorted) of balls grown by each body's motion over the step. A few
+// fast bodies would set the cell size for everyone (cells are 2 max radius + cutoff wide):
+// balls more than twice the largest body's own bounding radius are tested against every
+// body instead, O(N) each, as long as there are at most 64 of them.
+inline std::vector<BodyPair> swept_candidates(const Mat3X& centres, const VecX& radii, double body_radius,
+                                              double cutoff, const std::optional<PeriodicBox>& box, CellList& list) {
+  const auto n = centres.cols();
+  std::vector<Eigen::Index> slow, fast;
+  for (Eigen::Index k = 0; k < n; ++k) (radii[k] > 2.0 * body_radius ? fast : slow).push_back(k);
+  if (fast.empty() || fast.size() > 64) return list.find_pairs(centres, radii, cutoff, box);
+  Mat3X slow_centres(3, static_cast<Eigen::Index>(slow.size()));
+  VecX slow_radii(static_cast<Eigen::Index>(slow.size()));
+  for (std::size_t k = 0; k < slow.size(); ++k) {
+    slow_centres.col(static_cast<Eigen::Index>(k)) = centres.col(slow[k]);
+    slow_radii[static_cast<Eigen::Index>(k)] = radii[slow[k]];
+  }
+  std::vector<BodyPair> out;
+  for (const BodyPair& p : list.find_pairs(slow_centres, slow_radii, cutoff, box))
+    out.push_back({slow[static_cast<std::size_t>(p.i)], slow[static_cast<std::size_t>(p.j)]});
+  const double r_max = radii.maxCoeff();
+  for (const Eigen::Index f : fast) {
+    if (box && radii[f] + r_max + cutoff > 0.5 * box->lengths.minCoeff())
+      fail_argument("PeriodicBox.lengths", "body " + std::to_string(f) + " moves too far in the step for the box: " +
+                                               "its reach " + std::to_string(radii[f] + r_max + cutoff) +
+                                               " exceeds half the shortest side");
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (k == f || (radii[k] > 2.0 * body_radius && k < f)) continue;  // fast pairs once
+      if (is_candidate_pair(centres.col(f), centres.col(k), radii[f], radii[k], cutoff, box))
+        out.push_back({std::min(f, k), std::max(f, k)});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace detail
+
+// DTryRule::relative at the trial configuration `trial` = Q_t + dt Psi U.
+template <Shape S>
+RelativePairs find_pairs_relative(std::span<const S> shapes, std::span<const Pose> trial, const VecX& U,
+                                  int dofs_per_body, double dt, double d_hat, double multiplier,
+                                  const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
+  validate_scene(shapes, trial);
+  detail::require_velocities(U, trial.size(), dofs_per_body);
+  detail::d_try_from_speed(d_hat, dt, 0.0, multiplier);  // checks d_hat, dt, multiplier
+  const std::size_t n = trial.size();
+  const Vec3 mean = detail::mean_velocity(U, n, dofs_per_body);
+  Mat3X centres;
+  VecX radii;
+  detail::broad_phase_input(shapes, trial, centres, radii);
+  const double body_radius = radii.size() > 0 ? radii.maxCoeff() : 0.0;
+  std::vector<RigidVelocity> v(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] = rigid_velocity(U, k, dofs_per_body);
+    const double own = (v[k].u - mean).norm() + v[k].omega.norm() * centre_curve_reach(shape_of(shapes, k));
+    radii[static_cast<Eigen::Index>(k)] += multiplier * dt * own;
+  }
+  CellList local;
+  CellList& list = cells != nullptr ? *cells : local;
+  RelativePairs out;
+  for (const BodyPair& c : detail::swept_candidates(centres, radii, body_radius, multiplier * d_hat, box, list)) {
+    const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
+    const S& si = shape_of(shapes, i);
+    const S& sj = shape_of(shapes, j);
+    const double d_try = multiplier * (d_hat + dt * distance_rate_bound(si, v[i], sj, v[j]));
+    if (!is_candidate_pair(trial[i].x, trial[j].x, bounding_radius(si), bounding_radius(sj), d_try, box)) continue;
+    ContactPair pair = detail::contact_pair(shapes, trial, c.i, c.j, box);
+    if (pair.points.distance <= d_try) {
+      out.pairs.push_back(pair);
+      out.d_try.push_back(d_try);
+    }
+  }
+  return out;
+}
+
+// A pair whose distance along the motion reaches the threshold, at the first such time.
+struct TrajectoryCrossing {
+  Eigen::Index i = 0;
+  Eigen::Index j = 0;
+  Vec3 image_shift = Vec3::Zero();  // body j enters as its image at x_j + image_shift
+  SweptDistance first;              // first_time_below's answer (below = true)
+};
+
+// Every pair (i < j) whose d^P along Q_t + t' Psi V drops to `threshold` for some t' in
+// [0, dt], found within `tolerance` (a pair that comes within tolerance of it counts).
+template <Shape S>
+std::vector<TrajectoryCrossing> trajectory_crossings(std::span<const S> shapes, std::span<const Pose> poses,
+                                                     const VecX& V, int dofs_per_body, double dt, double threshold,
+                                                     double tolerance, const std::optional<PeriodicBox>& box = {},
+                                                     CellList* cells = nullptr) {
+  validate_scene(shapes, poses);
+  detail::require_velocities(V, poses.size(), dofs_per_body);
+  require_positive(dt, "dt");
+  require_finite(threshold, "threshold");
+  require_positive(tolerance, "tolerance");
+  const std::size_t n = poses.size();
+  const Vec3 mean = detail::mean_velocity(V, n, dofs_per_body);
+  Mat3X centres;
+  VecX radii;
+  detail::broad_phase_input(shapes, poses, centres, radii);
+  const double body_radius = radii.size() > 0 ? radii.maxCoeff() : 0.0;
+  std::vector<RigidVelocity> v(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] = rigid_velocity(V, k, dofs_per_body);
+    const Vec3 drift = 0.5 * dt * (v[k].u - mean);
+    centres.col(static_cast<Eigen::Index>(k)) += drift;
+    radii[static_cast<Eigen::Index>(k)] += drift.norm();
+  }
+  CellList local;
+  CellList& list = cells != nullptr ? *cells : local;
+  std::vector<TrajectoryCrossing> out;
+  const double cutoff = std::max(0.0, threshold) + tolerance;
+  for (const BodyPair& c : detail::swept_candidates(centres, radii, body_radius, cutoff, box, list)) {
+    const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
+    const Vec3 shift = minimum_image_shift(centres.col(c.i), centres.col(c.j), box);
+    SweptDistance first = first_time_below(shape_of(shapes, i), poses[i], v[i], shape_of(shapes, j),
+                                           shifted(poses[j], shift), v[j], dt, threshold, tolerance);
+    if (first.below) out.push_back({c.i, c.j, shift, std::move(first)});
+  }
+  return out;
+}
+
+}  // namespace stokescontact
