@@ -8,9 +8,11 @@
 #include <cstddef>
 #include <cstdio>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/solvers/contact_solver.hpp"
 #include "stokescontact/contact/solvers/lcp_sequence.hpp"
@@ -198,4 +200,39 @@ TEST(RodChain, ChainOfFiveMovesAsOneWithTheExactForces) {
                   1e-7 * d_hat + 4.0 * (target - d_hat));
     }
   }
+}
+
+// LineContactRods (geometry/line_contact.hpp) in the contact layer: the pair keeps d^P as its
+// distance, and D applies the force at the line contact. Rod a along z at the origin (centre
+// segment z in [-1/2, 1/2], radius 1/2), rod b 3 long through (1.2, 0, 0) along (-sin alpha, 0,
+// cos alpha). The centre-line gap at height z of a is 1.2 cos(alpha) - z sin(alpha), smallest at
+// a's top end; with c = sin(alpha) / width the force sits at z_w = (c / 12) / (1 - c / 2) on a,
+// along n = (cos alpha, 0, sin alpha), so D's torque on a is -(z_w e_z x n) = (0, -z_w cos alpha,
+// 0). A plain Spherocylinder pair has its force at the top end instead: torque -0.5 cos alpha.
+TEST(LineContactRods, ContactMatrixActsAtTheLineContact) {
+  const double alpha = 0.01, width = 0.1;
+  const sc::LineContactRod a{sc::Spherocylinder{1.0, 0.5}, {width, 0.05}};
+  const sc::LineContactRod b{sc::Spherocylinder{3.0, 0.5}, {width, 0.05}};
+  const std::vector<sc::Pose> poses = {{sc::Vec3::Zero(), sc::Quat::Identity()},
+                                       {sc::Vec3(1.2, 0, 0), sc::Quat(Eigen::AngleAxisd(-alpha, sc::Vec3::UnitY()))}};
+  const double exact = 1.2 * std::cos(alpha) - 0.5 * std::sin(alpha) - 1.0;
+  const double c = std::sin(alpha) / width, z_w = (c / 12.0) / (1.0 - 0.5 * c);
+  const std::vector<sc::LineContactRod> line_shapes{a, b};
+  const auto line_pairs = sc::find_contact_pairs(std::span<const sc::LineContactRod>(line_shapes),
+                                                 std::span<const sc::Pose>(poses), 0.5);
+  ASSERT_EQ(line_pairs.size(), 1u);
+  EXPECT_NEAR(line_pairs[0].points.distance, exact, 1e-14);  // d^P unchanged
+  ASSERT_TRUE(line_pairs[0].force_points.has_value());
+  EXPECT_NEAR(line_pairs[0].force_points->curve_point_a.z(), z_w, 3e-4 * z_w);
+  const auto D_line = sc::contact_matrix(std::span<const sc::ContactPair>(line_pairs), std::span<const sc::Pose>(poses));
+  EXPECT_NEAR(D_line.coeff(0, 0), -std::cos(alpha), 1e-12);  // force -n on a
+  EXPECT_NEAR(D_line.coeff(2, 0), -std::sin(alpha), 1e-12);
+  EXPECT_NEAR(D_line.coeff(4, 0), -z_w * std::cos(alpha), 3e-4 * z_w);
+  // The same rods as plain Spherocylinders: the closest points, at a's top end.
+  const std::vector<sc::Spherocylinder> plain{a, b};
+  const auto pairs = sc::find_contact_pairs(std::span<const sc::Spherocylinder>(plain), std::span<const sc::Pose>(poses), 0.5);
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_FALSE(pairs[0].force_points.has_value());
+  const auto D = sc::contact_matrix(std::span<const sc::ContactPair>(pairs), std::span<const sc::Pose>(poses));
+  EXPECT_NEAR(D.coeff(4, 0), -0.5 * std::cos(alpha), 1e-12);
 }
