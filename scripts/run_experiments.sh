@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# The contact-solver experiments of docs/results.md (Broms & Tornberg Fig. 4, Table 1, and the
-# speed-versus-error comparison, contact over the whole step). Builds the drivers in Release, writes JSON lines to
+# The contact-solver experiments of docs/results.md (Broms & Tornberg Fig. 4, Table 1, the
+# speed-versus-error comparison, contact over the whole step, the rod chains of Fig. 7 and the
+# biaxial compression of Fig. 8 with Table 2). Builds the drivers in Release, writes JSON lines to
 # docs/data/ and the printed summaries to docs/data/*.txt. About 45 minutes on 2 cores.
-# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step] ... (default: all)
+# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8] ... (default: all)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release -DSTOKESCONTACT_BUILD_TESTS=OFF -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build --preset release -j "$(nproc 2>/dev/null || echo 2)" --target fig4_spheres speed_vs_error continuous_detection
+cmake --build --preset release -j "$(nproc 2>/dev/null || echo 2)" --target fig4_spheres speed_vs_error \
+  continuous_detection fig7_rod_chains fig8_biaxial
 bin=build/release/examples
 data=docs/data
 mkdir -p "$data"
@@ -17,7 +19,7 @@ run() {  # name, command...
   "$@" --output "$data/$name.jsonl" | tee "$data/$name.txt"
 }
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(fig4 fig4-multiblob table1 speed whole-step)
+[ ${#parts[@]} -eq 0 ] && parts=(fig4 fig4-multiblob table1 speed whole-step fig7 fig8)
 for part in "${parts[@]}"; do
   case $part in
     fig4)
@@ -35,6 +37,18 @@ for part in "${parts[@]}"; do
       run fig4_rpy_whole_step $bin/fig4_spheres --mobility rpy
       run fig4_rpy_whole_step_relative $bin/fig4_spheres --mobility rpy --d-try-rule relative
       run continuous_detection $bin/continuous_detection ;;
+    fig7)  # 700 chains per run, about a second each
+      run fig7_free_draining_default_particle $bin/fig7_rod_chains --solver default --directions particle
+      run fig7_free_draining_lcp-newton_particle $bin/fig7_rod_chains --solver lcp-newton --directions particle
+      run fig7_free_draining_default_line $bin/fig7_rod_chains --solver default --directions line
+      /usr/bin/python3 scripts/plot_fig7.py $data/fig7_free_draining_default_particle.jsonl docs/figures/fig7_rod_chains.png ;;
+    fig8)  # the six (d_hat, dt) of Table 2 per run, seconds each
+      for solver in default lcp-newton; do
+        for directions in particle surface line; do
+          run fig8_free_draining_${solver}_$directions $bin/fig8_biaxial --solver $solver --directions $directions
+        done
+      done
+      /usr/bin/python3 scripts/plot_fig8.py docs/figures/fig8_biaxial.png $data/fig8_free_draining_*.jsonl ;;
     *) echo "unknown part $part" >&2; exit 2 ;;
   esac
 done

@@ -16,6 +16,7 @@
 #include "stokescontact/geometry/broad_phase.hpp"
 #include "stokescontact/geometry/centre_curve.hpp"
 #include "stokescontact/geometry/closest_points.hpp"
+#include "stokescontact/geometry/line_contact.hpp"
 #include "stokescontact/geometry/mass_tensors.hpp"
 #include "stokescontact/geometry/periodic_box.hpp"
 #include "stokescontact/geometry/point_distance.hpp"

@@ -8,9 +8,11 @@
 #include <cstddef>
 #include <cstdio>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/solvers/contact_solver.hpp"
 #include "stokescontact/contact/solvers/lcp_sequence.hpp"
@@ -150,3 +152,87 @@ TEST(ParallelRods, StackOfFiveDoesNotTurn) {
   }
 }
 
+
+// A chain of 5 rods in the setting of Broms & Tornberg Fig. 7 (Sec. 3.2.2): L_rod = 0.5, R_rod =
+// L_rod / 20, each rod the previous one turned by theta about the shift direction t = e_x and
+// shifted by beta t, every rod but the last pushed towards the next with |f| = 2 d_hat^(1/3),
+// dt = 0.05. With t along the common perpendicular the centre segments cross at angle theta
+// as seen along x, closest at their centres: the gap is beta - 2 R_rod, so beta = d_hat + 2 R_rod
+// gives every pair the gap d_hat. Free draining, all forces pass through the centres along x
+// (mobility mu across the axis, no torque): the chain must move as one, at 4 mu f / 5, so
+// lambda_k = (k + 1) f / 5 on the pair (k, k + 1), and no rod turns. The trial step alone
+// would close the last gap by dt mu f = 6 d_hat.
+TEST(RodChain, ChainOfFiveMovesAsOneWithTheExactForces) {
+  const double L_rod = 0.5, R_rod = L_rod / 20.0, d_hat = 1e-3, dt = 0.05, theta = 0.7;
+  const sc::Spherocylinder rod{L_rod - 2.0 * R_rod, R_rod};
+  const double f = 2.0 * std::cbrt(d_hat), beta = d_hat + 2.0 * R_rod;
+  const int n = 5;
+  std::vector<sc::Pose> poses;
+  for (int k = 0; k < n; ++k)
+    poses.push_back({sc::Vec3(k * beta, 0.0, 0.0), sc::Quat(Eigen::AngleAxisd(k * theta, sc::Vec3::UnitX()))});
+  const std::vector<sc::Spherocylinder> shapes{rod};
+  for (const SolverRun& run : runs()) {
+    SCOPED_TRACE(run.name);
+    sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, kViscosity), n, 6);
+    sc::VecX F = sc::VecX::Zero(6 * n);
+    for (int k = 0; k + 1 < n; ++k) F(6 * k) = f;
+    mobility.set_configuration(poses);
+    const sc::VecX U = mobility.apply(F);
+    const double mu = sc::spherocylinder_mobility(rod, kViscosity)(0, 0);
+    ASSERT_NEAR(dt * mu * f, 6.0 * d_hat, 0.5 * d_hat);  // the push would overlap the last pair
+    const sc::ContactStepProblem<sc::Spherocylinder> problem{shapes, poses, U, dt, d_hat, 0.0, 1.0, {}};
+    const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, {}, run.solver);
+    print("chain of five", run.name, r, poses);
+    EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+    EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-7);  // the LCP stops at a residual of 1e-8
+    EXPECT_LT(max_turn(poses, r.poses), 1e-12);
+    ASSERT_EQ(r.pairs.size(), static_cast<std::size_t>(n - 1));
+    // Each solver's target gap g: the pairs end at g, so the chain's ends differ by 4 (g - d_hat)
+    // from moving as one; lambda_k differs from (k + 1) f / 5 by at most (g - d_hat) / (dt mu).
+    const double target = run.target_gap / kDHat * d_hat;  // runs() states it for kDHat
+    const double slack = (target - d_hat) / (dt * mu);
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+      EXPECT_EQ(r.pairs[k].j, r.pairs[k].i + 1);
+      EXPECT_NEAR(r.lambda(static_cast<Eigen::Index>(k)), (r.pairs[k].i + 1) * f / 5.0, 1e-8 * f + 4.0 * slack)
+          << "pair " << r.pairs[k].i;
+      const auto a = static_cast<std::size_t>(r.pairs[k].i);
+      EXPECT_NEAR(sc::closest_points(rod, r.poses[a], rod, r.poses[a + 1]).distance, target,
+                  1e-7 * d_hat + 4.0 * (target - d_hat));
+    }
+  }
+}
+
+// LineContactRods (geometry/line_contact.hpp) in the contact layer: the pair keeps d^P as its
+// distance, and D applies the force at the line contact. Rod a along z at the origin (centre
+// segment z in [-1/2, 1/2], radius 1/2), rod b 3 long through (1.2, 0, 0) along (-sin alpha, 0,
+// cos alpha). The centre-line gap at height z of a is 1.2 cos(alpha) - z sin(alpha), smallest at
+// a's top end; with c = sin(alpha) / width the force sits at z_w = (c / 12) / (1 - c / 2) on a,
+// along n = (cos alpha, 0, sin alpha), so D's torque on a is -(z_w e_z x n) = (0, -z_w cos alpha,
+// 0). A plain Spherocylinder pair has its force at the top end instead: torque -0.5 cos alpha.
+TEST(LineContactRods, ContactMatrixActsAtTheLineContact) {
+  const double alpha = 0.01, width = 0.1;
+  const sc::LineContactRod a{sc::Spherocylinder{1.0, 0.5}, {width, 0.05}};
+  const sc::LineContactRod b{sc::Spherocylinder{3.0, 0.5}, {width, 0.05}};
+  const std::vector<sc::Pose> poses = {{sc::Vec3::Zero(), sc::Quat::Identity()},
+                                       {sc::Vec3(1.2, 0, 0), sc::Quat(Eigen::AngleAxisd(-alpha, sc::Vec3::UnitY()))}};
+  const double exact = 1.2 * std::cos(alpha) - 0.5 * std::sin(alpha) - 1.0;
+  const double c = std::sin(alpha) / width, z_w = (c / 12.0) / (1.0 - 0.5 * c);
+  const std::vector<sc::LineContactRod> line_shapes{a, b};
+  const auto line_pairs = sc::find_contact_pairs(std::span<const sc::LineContactRod>(line_shapes),
+                                                 std::span<const sc::Pose>(poses), 0.5);
+  ASSERT_EQ(line_pairs.size(), 1u);
+  EXPECT_NEAR(line_pairs[0].points.distance, exact, 1e-14);  // d^P unchanged
+  ASSERT_TRUE(line_pairs[0].force_points.has_value());
+  EXPECT_NEAR(line_pairs[0].force_points->curve_point_a.z(), z_w, 3e-4 * z_w);
+  const auto D_line = sc::contact_matrix(std::span<const sc::ContactPair>(line_pairs), std::span<const sc::Pose>(poses));
+  EXPECT_NEAR(D_line.coeff(0, 0), -std::cos(alpha), 1e-12);  // force -n on a
+  EXPECT_NEAR(D_line.coeff(2, 0), -std::sin(alpha), 1e-12);
+  EXPECT_NEAR(D_line.coeff(4, 0), -z_w * std::cos(alpha), 3e-4 * z_w);
+  // The same rods as plain Spherocylinders: the closest points, at a's top end.
+  const std::vector<sc::Spherocylinder> plain{a, b};
+  const auto pairs = sc::find_contact_pairs(std::span<const sc::Spherocylinder>(plain), std::span<const sc::Pose>(poses), 0.5);
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_FALSE(pairs[0].force_points.has_value());
+  const auto D = sc::contact_matrix(std::span<const sc::ContactPair>(pairs), std::span<const sc::Pose>(poses));
+  EXPECT_NEAR(D.coeff(4, 0), -0.5 * std::cos(alpha), 1e-12);
+}

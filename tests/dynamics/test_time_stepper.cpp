@@ -300,6 +300,53 @@ TEST(TimeStepper, RodsInBiaxialCompressionNeverOverlap) {
   }
 }
 
+// 50 steps of Broms & Tornberg's biaxial compression (Sec. 3.2.3, eq. 32, Table 2) on 6 of the
+// 30 rods: L_rod = 2 end to end, R_rod = 0.5 (centre segment 1), 3 columns at y spacing 1.5
+// and 2 rows at z spacing 3 (gaps R_rod side by side and L_rod / 2 tip to tip, the layout of
+// examples/fig8_biaxial.cpp), d_hat = 0.01 R_rod, dt = 0.02, free draining. Before any contact
+// forward Euler gives y_n = y_0 (1 - dt/2)^n, so the trial step of step n closes the side gap
+// to 1.5 (0.99)^n - 1, below d_hat first for n = 40 (ln(1.005/1.5)/ln(0.99) = 39.9), and the
+// tip gap to 3 (0.99)^n - 2, first for n = 41 (40.1). From then on the flow presses every step:
+// contacts are active at steps 40..50, 11 steps (the paper's count starts at its step 41 too:
+// 410 of 450). The rods are exactly parallel, every contact a line contact at the middle of
+// the overlap or tip to tip along the axis: no rod may leave x = 0 or turn, and the mirror
+// pair (y = -1.5, +1.5) stays mirrored.
+TEST(TimeStepper, BiaxialRodGridKeepsItsSymmetryAndContactCounts) {
+  using RodStepper = sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility>;
+  const sc::Spherocylinder rod{1.0, 0.5};
+  const double d_hat = 0.01 * rod.radius;
+  std::vector<sc::Pose> poses;
+  for (int row = 0; row < 2; ++row)
+    for (int col = 0; col < 3; ++col)
+      poses.push_back({sc::Vec3(0.0, 1.5 * (col - 1), 3.0 * (row - 0.5)), sc::Quat::Identity()});
+  for (const auto& [name, solver] : std::vector<std::pair<std::string, sc::ContactSolver>>{{"default", kDefault},
+                                                                                        {"lcp_sequence", kLcpSequence}}) {
+    SCOPED_TRACE(name);
+    sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
+    sc::TimeStepperOptions o = options(0.02, d_hat);
+    o.background_flow = sc::LinearBackgroundFlow::biaxial_compression(1.0);
+    RodStepper stepper({rod}, poses, mobility, solver, o);
+    std::vector<long> active_steps;
+    for (int step = 1; step <= 50; ++step) {
+      const sc::StepDiagnostics& d = stepper.step();
+      ASSERT_GE(d.min_distance_ratio, 1.0 - kMargin) << "step " << step;
+      if (d.active_pairs > 0) active_steps.push_back(d.step);
+      for (const sc::Pose& p : stepper.poses()) {
+        EXPECT_EQ(p.x.x(), 0.0) << "step " << step;
+        EXPECT_LT(p.q.angularDistance(sc::Quat::Identity()), 1e-12) << "step " << step;
+      }
+      const std::vector<sc::Pose>& q = stepper.poses();
+      for (const std::size_t row : {0u, 3u}) {
+        EXPECT_NEAR(q[row].x.y(), -q[row + 2].x.y(), 1e-12) << "step " << step;
+        EXPECT_NEAR(q[row].x.z(), q[row + 2].x.z(), 1e-12) << "step " << step;
+      }
+    }
+    ASSERT_FALSE(active_steps.empty());
+    EXPECT_EQ(active_steps.front(), 40);
+    EXPECT_EQ(active_steps.size(), 11u);
+  }
+}
+
 // A step whose contact solve fails separation throws and leaves Q_t. A at 0 rushes into B
 // at 2.5; B, pushed by the contact, hits C at 4.6, a pair the trial step does not flag
 // (B is at rest there, 0.1 > d_try away). Without guarantee rounds the solve must fail.

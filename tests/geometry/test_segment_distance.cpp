@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "geometry/brute_force.hpp"
+#include "stokescontact/geometry/line_contact.hpp"
 #include "stokescontact/geometry/segment_distance.hpp"
 
 namespace sc = stokescontact;
@@ -326,4 +329,91 @@ TEST(SegmentDistance, ArgumentOrderMirrorsExactly) {
     EXPECT_EQ(ab.parameter_b, ba.parameter_a);
     EXPECT_EQ(ab.point_a, ba.point_b);
   }
+}
+
+// ---------------------------------------------------------------------------------------
+// Line contacts (line_contact.hpp): where the force of a near-parallel pair acts.
+
+namespace {
+
+// a along z on [-1/2, 1/2]; b through (1, 0, 0) along (-sin alpha, 0, cos alpha), 3 long, so a
+// projects inside b. The gap from a's point at height z to b's line is cos(alpha) - z sin(alpha)
+// (exactly linear), smallest at z = 1/2; with c = sin(alpha) / width the weights are
+// w(z) = 1 - c (1/2 - z) (all positive for c < 1) and their centroid is
+// z_w = int z w / int w = (c / 12) / (1 - c / 2).
+Segment unit_a() { return {Vec3(0, 0, -0.5), Vec3(0, 0, 0.5)}; }
+Segment tilted_b(double alpha) {
+  const Vec3 u(-std::sin(alpha), 0.0, std::cos(alpha));
+  return {Vec3(1, 0, 0) - 1.5 * u, Vec3(1, 0, 0) + 1.5 * u};
+}
+double centroid_height(double alpha, double width) {
+  const double c = std::sin(alpha) / width;
+  return (c / 12.0) / (1.0 - 0.5 * c);
+}
+
+}  // namespace
+
+TEST(LineContact, ParallelSegmentsMeetAtTheMiddleOfTheOverlap) {
+  // a on z in [0, 1], b on z in [0.2, 2.2] one unit away along x: overlap z in [0.2, 1].
+  const Segment a{Vec3(0, 0, 0), Vec3(0, 0, 1)}, b{Vec3(1, 0, 0.2), Vec3(1, 0, 2.2)};
+  const auto c = sc::line_contact(a, b, {0.1, 0.05});
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->parameter_a, 0.6, 1e-14);
+  EXPECT_NEAR(c->parameter_b, 0.2, 1e-14);
+  EXPECT_NEAR((c->point_a - Vec3(0, 0, 0.6)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR((c->point_b - Vec3(1, 0, 0.6)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR((c->normal - Vec3(1, 0, 0)).norm(), 0.0, 1e-14);
+  EXPECT_EQ(c->share, 1.0);
+}
+
+TEST(LineContact, SmallTiltMovesTheForceToTheWeightedCentroid) {
+  for (const double alpha : {1e-3, 1e-2, -1e-2}) {
+    for (const double width : {0.1, 1.0}) {
+      SCOPED_TRACE(std::to_string(alpha) + " width " + std::to_string(width));
+      const auto c = sc::line_contact(unit_a(), tilted_b(alpha), {width, 0.05});
+      ASSERT_TRUE(c.has_value());
+      // alpha < 0 mirrors the gap: closest at z = -1/2, centroid at -z_w.
+      const double expected = (alpha > 0 ? 1.0 : -1.0) * centroid_height(std::abs(alpha), width);
+      // The 64-point midpoint rule integrates z w (quadratic) with relative error h^2 = 2.4e-4.
+      EXPECT_NEAR(c->point_a.z(), expected, 3e-4 * std::abs(expected) + 1e-15);
+      EXPECT_NEAR(c->point_a.x(), 0.0, 1e-15);
+      // The point on b is a's point projected onto b, and the normal is their separation.
+      const Vec3 sep = c->point_b - c->point_a;
+      EXPECT_NEAR(sep.dot(tilted_b(alpha).p1 - tilted_b(alpha).p0), 0.0, 1e-12);
+      EXPECT_NEAR((c->normal - sep.normalized()).norm(), 0.0, 1e-14);
+    }
+  }
+}
+
+TEST(LineContact, SpreadingFadesBetweenOneAndTwoAnglesAndIsGoneBeyond) {
+  const double angle = 0.05, width = 0.1;
+  // alpha = 1.5 angle: half the spread point, half the closest point (z = 1/2, a's end).
+  const double alpha = 1.5 * angle;
+  const auto c = sc::line_contact(unit_a(), tilted_b(alpha), {width, angle});
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->share, 0.5, 1e-12);
+  EXPECT_NEAR(c->point_a.z(), 0.5 * 0.5 + 0.5 * centroid_height(alpha, width), 3e-4 * 0.3);
+  EXPECT_FALSE(sc::line_contact(unit_a(), tilted_b(2.0 * angle + 1e-9), {width, angle}).has_value());
+  // Crossing segments: none.
+  EXPECT_FALSE(sc::line_contact(unit_a(), Segment{Vec3(1, -1, 0), Vec3(1, 1, 0)}, {width, angle}).has_value());
+  // End to end (no overlap of the projections): none.
+  EXPECT_FALSE(sc::line_contact(unit_a(), Segment{Vec3(0, 0, 1), Vec3(0, 0, 2)}, {width, angle}).has_value());
+}
+
+TEST(LineContact, ContinuousThroughParallelAndMirroredWhenSwapped) {
+  // The closest points jump from one end of the overlap to the other as alpha passes 0; the
+  // line contact moves by O(alpha).
+  const auto minus = sc::line_contact(unit_a(), tilted_b(-1e-9), {1.0, 0.05});
+  const auto plus = sc::line_contact(unit_a(), tilted_b(1e-9), {1.0, 0.05});
+  ASSERT_TRUE(minus && plus);
+  EXPECT_LT((minus->point_a - plus->point_a).norm(), 1e-9);
+  EXPECT_GT((sc::closest_points(unit_a(), tilted_b(-1e-9)).point_a - sc::closest_points(unit_a(), tilted_b(1e-9)).point_a).norm(),
+            0.5);
+  const auto swapped = sc::line_contact(tilted_b(1e-2), unit_a(), {1.0, 0.05});
+  const auto straight = sc::line_contact(unit_a(), tilted_b(1e-2), {1.0, 0.05});
+  ASSERT_TRUE(swapped && straight);
+  EXPECT_EQ(swapped->point_a, straight->point_b);
+  EXPECT_EQ(swapped->point_b, straight->point_a);
+  EXPECT_EQ(swapped->normal, Vec3(-straight->normal));
+  EXPECT_THROW((void)sc::line_contact(unit_a(), tilted_b(0.0), {0.0, 0.05}), std::invalid_argument);
 }

@@ -19,6 +19,8 @@
 // finite-difference test of D^T U against dd/dt confirms.)
 //
 // d^P (Broms eq. 20-21): one point pair per contact, the closest points; the force has unit norm.
+// Line contacts of LineContactRods put that point pair where geometry/line_contact.hpp spreads
+// the force of a near-parallel pair (ContactPair::force_points) instead.
 // d^S (Broms eq. 22-23): the sum over the contact's node pairs l of w_l (gradient of d_l), with
 // weights w_l = -b'(d_l) of a barrier with threshold d_try (b0 by default: w_l = 1/d_l as in
 // the paper, regularised by eps_reg / eps_cap so overlapping node pairs get finite weights),
@@ -103,7 +105,7 @@ inline bool valid_point_pair(const Vec3& point_i, const Vec3& point_j, const Vec
 inline ContactColumn particle_contact_column(const ContactPair& pair, std::span<const Pose> poses,
                                              const std::string& field) {
   const auto [x_i, x_j] = pair_centres(pair.i, pair.j, pair.image_shift, poses, field);
-  const ClosestPoints& cp = pair.points;
+  const ClosestPoints& cp = pair.force_points ? *pair.force_points : pair.points;  // a line contact's, if any
   if (!valid_point_pair(cp.point_a, cp.point_b, cp.normal)) fail_point_pair(field + ".points");
   ContactColumn c{pair.i, pair.j};
   add_distance_gradient(c, cp.normal, cp.point_a - x_i, cp.point_b - x_j, 1.0);
@@ -126,7 +128,7 @@ inline ContactColumn surface_contact_column(const SurfaceContact& contact, std::
     add_distance_gradient(c, p.normal, p.point_a - x_i, p.point_b - x_j, w);
   }
   if (weight_sum == 0.0)  // every node pair sits at d_try: fall back to the closest points
-    return particle_contact_column({contact.i, contact.j, contact.image_shift, contact.distances.particle}, poses,
+    return particle_contact_column({contact.i, contact.j, contact.image_shift, contact.distances.particle, std::nullopt}, poses,
                                    field + ".distances.particle");
   const double scale = 1.0 / std::max(c.force_j.norm(), weights.min_net_force_fraction * weight_sum);
   c.force_j *= scale;

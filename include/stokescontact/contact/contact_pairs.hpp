@@ -12,12 +12,14 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <type_traits>
 #include <span>
 #include <vector>
 
 #include "stokescontact/contact/scene.hpp"
 #include "stokescontact/geometry/broad_phase.hpp"
 #include "stokescontact/geometry/closest_points.hpp"
+#include "stokescontact/geometry/line_contact.hpp"
 
 namespace stokescontact {
 
@@ -28,6 +30,10 @@ struct ContactPair {
   Eigen::Index j = 0;
   Vec3 image_shift = Vec3::Zero();
   ClosestPoints points;
+  // Where the contact matrix applies the pair's force when it is not at the closest points:
+  // a line contact of two LineContactRods (geometry/line_contact.hpp), its distance the gap
+  // at those points. `points` keeps d^P, the distance the contact step constrains.
+  std::optional<ClosestPoints> force_points;
 };
 
 inline Pose shifted(const Pose& pose, const Vec3& shift) { return {pose.x + shift, pose.q}; }
@@ -49,8 +55,25 @@ template <Shape S>
 ContactPair contact_pair(std::span<const S> shapes, std::span<const Pose> poses, Eigen::Index i, Eigen::Index j,
                          const std::optional<PeriodicBox>& box) {
   const auto si = static_cast<std::size_t>(i), sj = static_cast<std::size_t>(j);
-  ContactPair pair{i, j, minimum_image_shift(poses[si].x, poses[sj].x, box), {}};
-  pair.points = closest_points(shape_of(shapes, si), poses[si], shape_of(shapes, sj), shifted(poses[sj], pair.image_shift));
+  ContactPair pair{i, j, minimum_image_shift(poses[si].x, poses[sj].x, box), {}, std::nullopt};
+  const S& a = shape_of(shapes, si);
+  const S& b = shape_of(shapes, sj);
+  const Pose pose_b = shifted(poses[sj], pair.image_shift);
+  pair.points = closest_points(a, poses[si], b, pose_b);
+  if constexpr (std::is_same_v<S, LineContactRod>) {
+    const auto line = line_contact(to_world(centre_curve(a), poses[si]).segments[0],
+                                   to_world(centre_curve(b), pose_b).segments[0],
+                                   {std::min(a.line.width, b.line.width), std::min(a.line.angle, b.line.angle)});
+    if (line) {
+      ClosestPoints& f = pair.force_points.emplace();
+      f.normal = line->normal;
+      f.curve_point_a = line->point_a;
+      f.curve_point_b = line->point_b;
+      f.point_a = line->point_a + a.radius * line->normal;
+      f.point_b = line->point_b - b.radius * line->normal;
+      f.distance = (line->point_b - line->point_a).norm() - a.radius - b.radius;
+    }
+  }
   return pair;
 }
 
