@@ -76,7 +76,7 @@ struct ContactStepOptions {
   // Re-solves after adding pairs the trial step missed (the guarantee loop).
   int max_guarantee_rounds = 3;
   ContactDirections directions = ContactDirections::automatic;
-  // Surface-node spacing h for eq. 23; 0: half the shape's radius.
+  // Surface-node spacing h for eq. 23; 0: contact_node_spacing(shape, d_hat).
   double node_spacing = 0.0;
   SurfaceWeights surface_weights;
 
@@ -187,7 +187,7 @@ class ContactStep {
     }
     if (options.surface_directions<S>()) {
       for (const S& shape : problem.shapes)
-        nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : 0.5 * shape.radius));
+        nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : contact_node_spacing(shape, problem.d_hat)));
     }
     trial_ = advance_all(problem.poses, problem.U, dofs_, problem.dt);  // Q*, eq. 16
     pairs_ = find_contact_pairs(problem.shapes, std::span<const Pose>(trial_), d_try_, problem.box);
