@@ -162,11 +162,9 @@ double first_separating_lambda(Step& step, double target, double step_size, doub
 // dt 0.01, d_hat = g): the distance is not monotone along the force (the closest points jump
 // between the three arm contacts as the bodies turn), so between lambda = 0 and the smallest
 // separating lambda d falls before it rises. The default solver's linear model stalled in
-// that dip (failed separation, d / d_hat = 0.67 after 50 corrections with d^P directions) or
-// may converge to a far root; it must return the first crossing along its direction, which
-// the test finds by brute force. With surface directions the node spacing follows d_hat
-// (contact_node_spacing): at h = R / 2 the node pairs miss the contacts and the force is d^P's
-// 1467 (15x the push); resolved, the contacts hold the push with less than 1.2x it.
+// that dip (failed separation, d / d_hat = 0.67 after 50 corrections with d^P directions and
+// 0.81 with d^S at g = 0.05) or may converge to a far root; it must return the first crossing
+// along its direction, which the test finds by brute force.
 TEST(ContactStepSurface, InterlockedBoomerangsGetTheSmallestSeparatingForce) {
   const sc::Boomerang b = sc::broms_tornberg_boomerang();
   const std::vector<sc::Boomerang> shapes{b};
@@ -197,9 +195,39 @@ TEST(ContactStepSurface, InterlockedBoomerangsGetTheSmallestSeparatingForce) {
       sc::ContactStep<sc::Boomerang, sc::FreeDrainingMobility> step(p, m2, options);
       const double reference = first_separating_lambda(step, g, 0.5, 5000.0);
       EXPECT_NEAR(r.lambda(0), reference, 1e-3 * reference);
-      if (directions == sc::ContactDirections::automatic) {
-        EXPECT_LE(r.lambda(0), 120.0);
+    }
+  }
+}
+
+// contact_node_spacing's promise on the interlocked pair: at each of the three arm contacts
+// (gap g = d_hat) some node pair measures the gap to within d_hat / 4 (the sagitta bound
+// h^2 / (4 R)). Half the radius, the former default, misses a contact by more than g at g = 0.01.
+TEST(ContactStepSurface, NodeSpacingResolvesEveryArmContactOfInterlockedBoomerangs) {
+  const sc::Boomerang b = sc::broms_tornberg_boomerang();
+  for (const double g : {0.05, 0.01}) {
+    sc::Vec3 n;
+    const std::vector<sc::Pose> poses = interlocked_boomerangs(b, g, n);
+    // The contacts on A's surface (A's construction frame is the world frame here).
+    const double r = b.radius, reach = b.radius + b.bend_radius + g;
+    const std::vector<sc::Vec3> contacts{sc::Vec3(r, 0, reach), sc::Vec3(reach, 0, r), sc::Vec3(reach, -r, 0)};
+    const auto worst_contact = [&](double h) {
+      const sc::SurfaceNodes nodes = sc::surface_nodes(b, h);
+      const sc::SurfaceDistances d = sc::surface_distances(b, poses[0], nodes, b, poses[1], nodes, 1.0);
+      double worst = 0.0;
+      for (const sc::Vec3& c : contacts) {
+        double best = std::numeric_limits<double>::infinity();
+        for (const sc::SurfacePair& p : d.pairs)
+          if (p.source != sc::PairSource::closest_points && (p.point_a - c).norm() < 2.0 * h)
+            best = std::min(best, p.distance);
+        worst = std::max(worst, best - g);
       }
+      return worst;
+    };
+    const double h = sc::contact_node_spacing(b, g);
+    EXPECT_NEAR(h, std::sqrt(b.radius * g), 1e-15);
+    EXPECT_LE(worst_contact(h), 0.25 * g) << "g " << g << ", h " << h;
+    if (g == 0.01) {
+      EXPECT_GT(worst_contact(0.5 * b.radius), g);
     }
   }
 }
