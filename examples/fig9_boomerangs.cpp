@@ -7,15 +7,21 @@
 // application, not counted); one contact step with dt = 0.01 and d^S directions (eq. 22-23).
 //
 //   fig9_boomerangs [--configs 200] [--seed 1] [--boomerangs 40] [--side 12] [--min-gap 1e-2]
-//                   [--solver NAME] [--mobility free-draining|multiblob] [--blob-spacing H]
-//                   [--cost formed|matrix-free] [--directions surface|particle] [--output FILE]
+//                   [--solver NAME] [--mobility free-draining|multiblob] [--blob-model curve|surface]
+//                   [--blob-spacing H] [--cost formed|matrix-free] [--directions surface|particle] [--output FILE]
+//   fig9_boomerangs --resolution [--spacings 0.5,0.35,0.25,0.18,0.125] [--reference-spacing 0.09]
 //
 // Prints one JSON object per configuration (to --output if given, else stdout), then a summary.
 // Per configuration: d_hat, d_try, min d over all pairs after / d_hat (9b), the flagged pairs'
 // d^P at the trial step and after the correction (9c), status, mobility applications, wall time.
 // Mobility: free-draining = each body alone, its 6x6 mobility from the boomerang's curve blobs
-// (boomerang_curve_blobs, --blob-spacing, default the tube radius); multiblob = the same blobs
-// coupled by RPY (the paper's rigid multiblob method), matrix-free GMRES.
+// (--blob-model curve: boomerang_curve_blobs, --blob-spacing default the tube radius; surface:
+// boomerang_surface_blobs at --blob-spacing, default 0.25); multiblob = the same blobs coupled
+// by RPY (the paper's rigid multiblob method), matrix-free GMRES.
+// --resolution: the single-body mobility of the boomerang's blob grids (the curve chain, the
+// surface grids at --spacings) against a finer surface grid (--reference-spacing) taken as
+// the converged value: relative errors of the translation, rotation and coupling blocks
+// (Frobenius norms) and of the whole 6x6 matrix in the units where its blocks are comparable.
 #include <stokescontact/stokescontact.hpp>
 
 #include <cstdio>
@@ -34,8 +40,9 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: fig9_boomerangs [--configs 200] [--seed 1] [--boomerangs 40] [--side 12] [--min-gap 1e-2]\n"
-    "                       [--solver NAME] [--mobility free-draining|multiblob] [--blob-spacing H]\n"
-    "                       [--cost formed|matrix-free] [--directions surface|particle] [--output FILE]\n";
+    "                       [--solver NAME] [--mobility free-draining|multiblob] [--blob-model curve|surface]\n"
+    "                       [--blob-spacing H] [--cost formed|matrix-free] [--directions surface|particle] [--output FILE]\n"
+    "       fig9_boomerangs --resolution [--spacings 0.5,0.35,0.25,0.18,0.125] [--reference-spacing 0.09]\n";
 
 constexpr double kTimeStep = 0.01;
 constexpr double kForceMagnitude = 100.0;
@@ -48,9 +55,13 @@ struct Options {
   double min_gap = 1e-2;
   sc::ContactSolver solver;
   std::string mobility = "free-draining";
+  std::string blob_model = "curve";
   double blob_spacing = 0.0;
   sc::ContactStepOptions step;
   std::string output;
+  bool resolution = false;
+  std::vector<double> spacings;
+  double reference_spacing = 0.09;
 };
 
 Options parse(int argc, char** argv) {
@@ -65,7 +76,10 @@ Options parse(int argc, char** argv) {
   o.mobility = args.text("--mobility", "free-draining");
   if (o.mobility != "free-draining" && o.mobility != "multiblob")
     throw std::invalid_argument("--mobility must be free-draining or multiblob, got '" + o.mobility + "'");
-  o.blob_spacing = args.number("--blob-spacing", 0.0, 0.0);
+  o.blob_model = args.text("--blob-model", "curve");
+  if (o.blob_model != "curve" && o.blob_model != "surface")
+    throw std::invalid_argument("--blob-model must be curve or surface, got '" + o.blob_model + "'");
+  o.blob_spacing = args.number("--blob-spacing", o.blob_model == "surface" ? 0.25 : 0.0, 0.0);
   const std::string cost = args.text("--cost", "matrix-free");
   if (cost != "formed" && cost != "matrix-free")
     throw std::invalid_argument("--cost must be formed or matrix-free, got '" + cost + "'");
@@ -75,6 +89,9 @@ Options parse(int argc, char** argv) {
     throw std::invalid_argument("--directions must be surface or particle, got '" + directions + "'");
   o.step.directions = directions == "surface" ? sc::ContactDirections::surface : sc::ContactDirections::particle;
   o.output = args.text("--output", "");
+  o.resolution = args.flag("--resolution");
+  o.spacings = args.numbers("--spacings", {0.5, 0.35, 0.25, 0.18, 0.125}, 1e-3);
+  o.reference_spacing = args.number("--reference-spacing", 0.09, 1e-3);
   args.reject_unknown();
   return o;
 }
@@ -113,10 +130,15 @@ sc::VecX random_wrenches(std::size_t n, sc::Rng& rng) {
   return F;
 }
 
+sc::BlobModel blob_model(const Options& o, const sc::Boomerang& b) {
+  return o.blob_model == "surface" ? sc::boomerang_surface_blobs(b, o.blob_spacing)
+                                   : sc::boomerang_curve_blobs(b, o.blob_spacing);
+}
+
 using BoomerangMobility = std::variant<sc::FreeDrainingMobility, sc::MultiblobMobility>;
 
 BoomerangMobility make_mobility(const Options& o, const sc::Boomerang& b) {
-  const sc::BlobModel blobs = sc::boomerang_curve_blobs(b, o.blob_spacing);
+  const sc::BlobModel blobs = blob_model(o, b);
   if (o.mobility == "multiblob") {
     sc::MultiblobOptions options;
     options.solver = sc::MultiblobSolver::matrix_free;
@@ -136,6 +158,7 @@ void run(const Options& o, M& mobility) {
   const sc::Boomerang b = sc::broms_tornberg_boomerang();
   const std::vector<sc::Boomerang> shapes{b};
   ex::JsonLines sink(o.output);
+  const auto mobility_blobs = static_cast<std::size_t>(blob_model(o, b).positions.cols());
   Summary s;
   for (int c = 0; c < o.configs; ++c) {
     const std::uint64_t seed = o.seed + static_cast<std::uint64_t>(c);
@@ -158,7 +181,8 @@ void run(const Options& o, M& mobility) {
     const std::string json =
         "{\"record\": \"step\", \"seed\": " + std::to_string(seed) + ", \"config\": " + std::to_string(c) +
         ", \"boomerangs\": " + std::to_string(o.boomerangs) + ", \"side\": " + sc::json_number(o.side) +
-        ", \"mobility\": \"" + o.mobility + "\", \"solver\": \"" + sc::contact_solver_name(o.solver) +
+        ", \"mobility\": \"" + o.mobility + "\", \"blob_model\": \"" + o.blob_model +
+        "\", \"blobs_per_body\": " + std::to_string(mobility_blobs) + ", \"solver\": \"" + sc::contact_solver_name(o.solver) +
         "\", \"directions\": \"" + (o.step.directions == sc::ContactDirections::surface ? "surface" : "particle") +
         "\", \"d_hat\": " + sc::json_number(d_hat) + ", \"d_try\": " + sc::json_number(r.d_try) +
         ", \"flagged\": " + std::to_string(r.flagged_pairs) + ", \"min_d_over_d_hat_after\": " +
@@ -179,8 +203,9 @@ void run(const Options& o, M& mobility) {
     s.respects += r.min_distance_ratio >= 1.0 - 1e-9;
     s.converged += r.status == sc::ContactStepStatus::converged;
   }
-  std::printf("\nFig. 9: %zu boomerangs, side %g, %s mobility, solver %s, %s directions\n", o.boomerangs, o.side,
-              o.mobility.c_str(), sc::contact_solver_name(o.solver).c_str(),
+  std::printf("\nFig. 9: %zu boomerangs, side %g, %s mobility (%s blobs, %zu per body), solver %s, %s directions\n",
+              o.boomerangs, o.side, o.mobility.c_str(), o.blob_model.c_str(), mobility_blobs,
+              sc::contact_solver_name(o.solver).c_str(),
               o.step.directions == sc::ContactDirections::surface ? "surface" : "particle");
   std::printf("%7s | %-29s | %9s | %9s | %-13s | %9s | %6s\n", "configs", "min d/d_hat after (min med max)",
               "d>=d_hat", "converged", "apps (med max)", "med wall", "med Nc");
@@ -191,11 +216,54 @@ void run(const Options& o, M& mobility) {
               ex::maximum(s.applications), ex::median(s.wall), ex::median(s.nc));
 }
 
+// Relative errors of one body's 6x6 mobility against the reference, block by block; "all": the
+// matrix scaled by the boomerang's length scale ell (u, omega ell) / (f, tau / ell), in which
+// the three blocks are of one size.
+std::string resolution_row(const std::string& model, std::size_t blobs, double spacing, const sc::Mat6& M,
+                           const sc::Mat6& ref, double ell) {
+  const auto rel = [&](int r, int c) {
+    return (M.block<3, 3>(r, c) - ref.block<3, 3>(r, c)).norm() / ref.block<3, 3>(r, c).norm();
+  };
+  sc::Vec6 scale;
+  scale << 1, 1, 1, ell, ell, ell;
+  const sc::Mat6 a = scale.asDiagonal() * M * scale.asDiagonal(), b = scale.asDiagonal() * ref * scale.asDiagonal();
+  char line[300];
+  std::snprintf(line, sizeof line,
+                "{\"record\": \"resolution\", \"model\": \"%s\", \"blobs\": %zu, \"spacing\": %s, "
+                "\"err_translation\": %.3e, \"err_rotation\": %.3e, \"err_coupling\": %.3e, \"err_all\": %.3e}",
+                model.c_str(), blobs, sc::json_number(spacing).c_str(), rel(0, 0), rel(3, 3), rel(0, 3),
+                (a - b).norm() / b.norm());
+  return line;
+}
+
+void run_resolution(const Options& o) {
+  const sc::Boomerang b = sc::broms_tornberg_boomerang();
+  const double ell = sc::bounding_radius(b);
+  ex::JsonLines sink(o.output);
+  const sc::BlobModel reference = sc::boomerang_surface_blobs(b, o.reference_spacing);
+  const sc::Mat6 ref = sc::single_body_mobility(reference, 1.0);
+  std::printf("reference: surface blobs at h = %g (%lld blobs); errors relative to it\n", o.reference_spacing,
+              static_cast<long long>(reference.positions.cols()));
+  const sc::BlobModel curve = sc::boomerang_curve_blobs(b, o.blob_spacing);
+  sink.line(resolution_row("curve", static_cast<std::size_t>(curve.positions.cols()),
+                           o.blob_spacing > 0.0 ? o.blob_spacing : b.radius, sc::single_body_mobility(curve, 1.0), ref,
+                           ell));
+  for (const double h : o.spacings) {
+    const sc::BlobModel surface = sc::boomerang_surface_blobs(b, h);
+    sink.line(resolution_row("surface", static_cast<std::size_t>(surface.positions.cols()), h,
+                             sc::single_body_mobility(surface, 1.0), ref, ell));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
     const Options o = parse(argc, argv);
+    if (o.resolution) {
+      run_resolution(o);
+      return 0;
+    }
     BoomerangMobility mobility = make_mobility(o, sc::broms_tornberg_boomerang());
     std::visit([&](auto& m) { run(o, m); }, mobility);
     return 0;

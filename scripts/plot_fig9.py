@@ -51,8 +51,8 @@ def main(sources, target):
     before = np.concatenate([np.array(r["pair_d_before"]) / r["d_hat"] for r in rows])
     after = np.concatenate([np.array(r["pair_d_after"]) / r["d_hat"] for r in rows])
     bins = np.linspace(-10.0, 20.0, 121)
-    ax_c.hist(np.clip(before, bins[0], bins[-1]), bins=bins, alpha=0.6, label="before (trial step)")
-    ax_c.hist(np.clip(after, bins[0], bins[-1]), bins=bins, alpha=0.6, label="after")
+    for values, name in ((before, "before (trial step)"), (after, "after")):
+        ax_c.hist(np.clip(values, bins[0], bins[-1]), bins=bins, alpha=0.6, label=name)
     ax_c.axvline(1.0, color="k", lw=0.8)
     ax_c.set_yscale("log")
     ax_c.set_xlabel("d / d_hat of flagged pairs (clipped to [-10, 20])")
