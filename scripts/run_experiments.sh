@@ -2,7 +2,7 @@
 # The contact-solver experiments of docs/results.md (Broms & Tornberg Fig. 4, Table 1, Fig. 9 and
 # the speed-versus-error comparison). Builds the drivers in Release, writes JSON lines to
 # docs/data/ and the printed summaries to docs/data/*.txt. About 45 minutes on 2 cores.
-# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|fig9|speed] ... (default: all)
+# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|fig9|fig9-surface-blobs|speed] ... (default: all)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release -DSTOKESCONTACT_BUILD_TESTS=OFF -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF >/dev/null
@@ -35,7 +35,10 @@ for part in "${parts[@]}"; do
         done
       done
       /usr/bin/python3 scripts/plot_fig9.py $data/fig9_multiblob_default.jsonl $data/fig9_free_draining_default.jsonl \
-        docs/figures/fig9_boomerangs.png ;;
+        docs/figures/fig9_boomerangs.png
+      $bin/fig9_boomerangs --resolution --output $data/fig9_resolution.jsonl | tee $data/fig9_resolution.txt ;;
+    fig9-surface-blobs)  # resolved multiblob boomerangs (236 blobs each): ~40 s per configuration
+      run fig9_multiblob_surface_default $bin/fig9_boomerangs --mobility multiblob --blob-model surface --configs 10 ;;
     speed)
       run speed_vs_error $bin/speed_vs_error --mobility rpy --configs 10 --jammed-spheres 100 ;;
     *) echo "unknown part $part" >&2; exit 2 ;;
