@@ -13,7 +13,8 @@
 //
 // Prints one JSON object per configuration (to --output if given, else stdout), then a summary.
 // Per configuration: d_hat, d_try, min d over all pairs after / d_hat (9b), the flagged pairs'
-// d^P at the trial step and after the correction (9c), status, mobility applications, wall time.
+// d^P at the trial step and after the correction (9c), status, mobility applications, wall time,
+// the solver's message.
 // Mobility: free-draining = each body alone, its 6x6 mobility from the boomerang's curve blobs
 // (--blob-model curve: boomerang_curve_blobs, --blob-spacing default the tube radius; surface:
 // boomerang_surface_blobs at --blob-spacing, default 0.25); multiblob = the same blobs coupled
@@ -190,7 +191,7 @@ void run(const Options& o, M& mobility) {
         ", \"pair_d_after\": " + sc::json_array(std::span<const double>(after)) + ", \"status\": \"" +
         std::string(sc::to_string(r.status)) + "\", \"applications\": " + std::to_string(r.mobility_applications) +
         ", \"iterations\": " + std::to_string(r.iterations) + ", \"lambda_sum\": " + sc::json_number(r.lambda_sum) +
-        ", \"wall_time_s\": " + sc::json_number(r.wall_time_s) + "}";
+        ", \"wall_time_s\": " + sc::json_number(r.wall_time_s) + ", \"message\": " + sc::json_quoted(r.message) + "}";
     char progress[200];
     std::snprintf(progress, sizeof progress, "config %3d: d_hat %.3e Nc %3zu min d/d_hat %.6f apps %3zu %7.3f s %s", c,
                   d_hat, r.flagged_pairs, r.min_distance_ratio, r.mobility_applications, r.wall_time_s,
