@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # The contact-solver experiments of docs/results.md (Broms & Tornberg Fig. 4, Table 1, the
-# speed-versus-error comparison, contact over the whole step, the rod chains of Fig. 7 and the
-# biaxial compression of Fig. 8 with Table 2). Builds the drivers in Release, writes JSON lines to
-# docs/data/ and the printed summaries to docs/data/*.txt. About 45 minutes on 2 cores.
-# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8] ... (default: all)
+# speed-versus-error comparison, contact over the whole step, the rod chains of Fig. 7, the
+# biaxial compression of Fig. 8 with Table 2, the random boomerangs of Fig. 9). Builds the
+# drivers in Release, writes JSON lines to docs/data/ and the printed summaries to
+# docs/data/*.txt. About an hour on 2 cores.
+# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8|fig9|fig9-surface-blobs] ...
+#        (default: all but fig9-surface-blobs)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release -DSTOKESCONTACT_BUILD_TESTS=OFF -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build --preset release -j "$(nproc 2>/dev/null || echo 2)" --target fig4_spheres speed_vs_error \
-  continuous_detection fig7_rod_chains fig8_biaxial
+  continuous_detection fig7_rod_chains fig8_biaxial fig9_boomerangs
 bin=build/release/examples
 data=docs/data
 mkdir -p "$data"
@@ -19,7 +21,7 @@ run() {  # name, command...
   "$@" --output "$data/$name.jsonl" | tee "$data/$name.txt"
 }
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(fig4 fig4-multiblob table1 speed whole-step fig7 fig8)
+[ ${#parts[@]} -eq 0 ] && parts=(fig4 fig4-multiblob table1 speed whole-step fig7 fig8 fig9)
 for part in "${parts[@]}"; do
   case $part in
     fig4)
@@ -30,6 +32,17 @@ for part in "${parts[@]}"; do
     table1)
       run table1_rpy_default $bin/fig4_spheres --table1 --mobility rpy --solver default
       run table1_rpy_barrier_slsqp $bin/fig4_spheres --table1 --mobility rpy --solver barrier-slsqp --configs 10 ;;
+    fig9)  # 40 boomerangs, 200 configurations per run: about a minute in all
+      for solver in default lcp-newton barrier-slsqp; do
+        for mobility in free-draining multiblob; do
+          run "fig9_${mobility//-/_}_${solver//-/_}" $bin/fig9_boomerangs --mobility $mobility --solver $solver
+        done
+      done
+      /usr/bin/python3 scripts/plot_fig9.py $data/fig9_multiblob_default.jsonl $data/fig9_free_draining_default.jsonl \
+        docs/figures/fig9_boomerangs.png
+      $bin/fig9_boomerangs --resolution --output $data/fig9_resolution.jsonl | tee $data/fig9_resolution.txt ;;
+    fig9-surface-blobs)  # resolved multiblob boomerangs (236 blobs each): ~40 s per configuration
+      run fig9_multiblob_surface_default $bin/fig9_boomerangs --mobility multiblob --blob-model surface --configs 10 ;;
     speed)
       run speed_vs_error $bin/speed_vs_error --mobility rpy --configs 10 --jammed-spheres 100 ;;
     whole-step)  # no tunnelling, Galilean invariance, detection cost (~5 minutes)

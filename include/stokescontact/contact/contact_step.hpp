@@ -99,7 +99,7 @@ struct ContactStepOptions {
   // The guarantee over the whole step (carried contacts, the interior check); false: the
   // paper's check at the end of the step only, where bodies may pass through each other.
   bool whole_step = true;
-  // Surface-node spacing h for eq. 23; 0: half the shape's radius.
+  // Surface-node spacing h for eq. 23; 0: contact_node_spacing(shape, d_hat).
   double node_spacing = 0.0;
   SurfaceWeights surface_weights;
 
@@ -239,7 +239,7 @@ class ContactStep {
     }
     if (options.surface_directions<S>()) {
       for (const S& shape : problem.shapes)
-        nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : 0.5 * shape.radius));
+        nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : contact_node_spacing(shape, problem.d_hat)));
     }
     trial_ = advance_all(problem.poses, problem.U, dofs_, problem.dt);  // Q*, eq. 16
     const std::span<const Pose> trial(trial_);

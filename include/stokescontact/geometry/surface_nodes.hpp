@@ -221,6 +221,29 @@ inline SurfaceNodes surface_nodes(const Boomerang& b, double spacing) {
   return nb.finish(spacing);
 }
 
+// The node budget of contact_node_spacing: the finest spacing it picks gives about this many
+// nodes per shape (area / h^2).
+inline constexpr double kContactNodeBudget = 1.0e5;
+
+// The surface-node spacing for contact directions d^S (Broms eq. 22-23) that resolves a gap of
+// d_hat. The d^S pairs are the nodes of one body against the other body's exact surface, so
+// a node at lateral offset x from the true closest point sits farther than d^P by the sagitta
+// of the two surfaces, about x^2 / (2 R_rel), 1 / R_rel = 1 / R_a + 1 / R_b <= 2 / R for
+// tubes of radius R; the nearest node has x <= h / 2, an error of at most h^2 / (4 R). Only
+// node pairs within d_try (>= d_hat) join a contact, and their distances weight its force:
+// when that error is comparable to d_hat the only pair near the contact is the d^P pair, the
+// force is d^P's single direction (interlocked boomerangs at gap 0.01 with h = R / 2 were held
+// by 80x the push they resisted). So h^2 / (4 R) <= d_hat / 4, h = sqrt(R d_hat), never coarser
+// than half the radius (the tube then still has >= 12 lines around it), never so fine that the
+// node count exceeds kContactNodeBudget (then the error is above d_hat / 4: very small d_hat).
+template <Shape S>
+double contact_node_spacing(const S& shape, double d_hat) {
+  require_positive(d_hat, "d_hat");
+  const double resolving = std::sqrt(shape.radius * d_hat);
+  const double budget = std::sqrt(surface_area(shape) / kContactNodeBudget);
+  return std::max(budget, std::min(0.5 * shape.radius, resolving));
+}
+
 // Upsampled nodes: the same construction at spacing h / factor, factor >= 1.
 template <Shape S>
 SurfaceNodes upsampled_surface_nodes(const S& shape, double spacing, int factor) {

@@ -30,6 +30,16 @@
 //    dense clusters, whose many far fields add up), the round is finished by the LCP sequence
 //    with exact products, polished to complementarity (lcp_sequence.hpp).
 //
+//  - the distance need not grow monotonically along the force (non-convex shapes: interlocked
+//    boomerangs, whose closest points jump between arms as the bodies turn), so a converged
+//    lambda* may be a far root of eq. 27 with a smaller separating force on the same ray, and
+//    the corrections may stall in a dip of d between two roots. Along a ray s lambda, M D (s
+//    lambda) = s M D lambda, so Q(s lambda) and its distances cost no mobility application:
+//    at convergence the ray (0, lambda*] is sampled for its first crossing of the target and a
+//    smaller crossing is refined by bisection and polished by one more round (never searched
+//    again); a round whose corrections stall is sent along its best ray, doubled until it
+//    separates, and then back to the first crossing the same way (ray_first_crossing).
+//
 // Stopping rule (Broms eq. 29 form): at an iterate whose flagged pairs all have d >= d_hat, stop when
 // the next correction would change lambda by less than tol ||lambda||_inf; that iterate is
 // returned, so separation is measured, never predicted. The margin puts roundoff and the
@@ -63,6 +73,10 @@ struct DefectCorrectionOptions {
   double tol = 1e-4;                  // Broms eq. 29 rule on successive corrections
   double probe_radius_factor = 4.0;   // probe radius = factor x the largest bounding radius
   int max_iterations = 50;            // corrections per round
+  int ray_samples = 16;               // samples of the ray (0, lambda] for its first crossing
+  int stall_corrections = 3;          // corrections in a row that do not contract before the
+                                      // ray search (single-contact probes; shared ones go to
+                                      // the LCP sequence after two)
   double contraction = 0.5;           // a correction must shrink the shortfall by this factor ...
                                       // ... or, twice in a row, the LCP sequence takes over
   LcpOptions lcp{1e-12};              // each small LCP's stopping rule
@@ -73,6 +87,11 @@ struct DefectCorrectionOptions {
     require_positive(probe_radius_factor, "DefectCorrectionOptions.probe_radius_factor");
     if (!(contraction > 0.0 && contraction <= 1.0))
       fail_argument("DefectCorrectionOptions.contraction", "must lie in (0, 1], got " + std::to_string(contraction));
+    if (ray_samples < 2)
+      fail_argument("DefectCorrectionOptions.ray_samples", "must be >= 2, got " + std::to_string(ray_samples));
+    if (stall_corrections < 1)
+      fail_argument("DefectCorrectionOptions.stall_corrections",
+                    "must be >= 1, got " + std::to_string(stall_corrections));
     if (max_iterations < 1)
       fail_argument("DefectCorrectionOptions.max_iterations", "must be >= 1, got " + std::to_string(max_iterations));
     lcp.validate();
@@ -119,6 +138,45 @@ inline std::optional<VecX> solve_working_set_lcp(const MatX& A, std::span<const 
   return next;
 }
 
+// The smallest distance of the flagged pairs at Q(lambda) = Q_t + dt Psi (U + M D lambda)
+// (Broms eq. 13), given M D lambda: no mobility application.
+template <Shape S, MobilityOperator M>
+double min_flagged_distance_at(const ContactStep<S, M>& step, const VecX& MD_lambda) {
+  const ContactStepProblem<S>& p = step.problem();
+  const int dofs = static_cast<int>(p.U.size() / static_cast<Eigen::Index>(p.poses.size()));
+  const std::vector<Pose> poses = advance_all(p.poses, p.U + MD_lambda, dofs, p.dt);
+  double d = std::numeric_limits<double>::infinity();
+  for (const ContactPair& pair : step.pairs())
+    d = std::min(d, contact_pair(p.shapes, std::span<const Pose>(poses), pair.i, pair.j, p.box).points.distance);
+  return d;
+}
+
+// The first crossing of the target by the flagged distances on the ray s lambda, s in (0, s_max],
+// given M D lambda (so every sample is free, M D linear in lambda): the smallest of `samples`
+// equal steps whose min d >= target, refined by bisection against the step before it to a
+// relative width `tol`; the returned s separates. None when no sample separates. A separated
+// window narrower than one step can be missed: the samples bound the cost.
+template <Shape S, MobilityOperator M>
+std::optional<double> ray_first_crossing(const ContactStep<S, M>& step, const VecX& MD_lambda, double s_max,
+                                         double target, int samples, double tol) {
+  const auto separated = [&](double s) { return min_flagged_distance_at(step, s * MD_lambda) >= target; };
+  double lo = 0.0, hi = -1.0;
+  for (int j = 1; j <= samples; ++j) {
+    const double s = s_max * j / samples;
+    if (separated(s)) {
+      hi = s;
+      break;
+    }
+    lo = s;
+  }
+  if (hi < 0.0) return std::nullopt;
+  while (hi - lo > tol * hi) {
+    const double mid = 0.5 * (lo + hi);
+    (separated(mid) ? hi : lo) = mid;
+  }
+  return hi;
+}
+
 // The fallback of a round whose corrections do not contract.
 template <Shape S, MobilityOperator M>
 ContactSolveOutcome finish_by_lcp_sequence(ContactStep<S, M>& step, const VecX& lambda, int corrections,
@@ -134,10 +192,37 @@ ContactSolveOutcome finish_by_lcp_sequence(ContactStep<S, M>& step, const VecX& 
   return out;
 }
 
+template <Shape S, MobilityOperator M>
+ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX lambda,
+                                                  const DefectCorrectionOptions& options, bool search_rays = true);
+
+// The round again from s lambda, the first crossing of the ray found by ray_first_crossing
+// (no further ray search): its result when it separates with no more total force, else s
+// lambda itself, which separates. `before`: the corrections spent so far.
+template <Shape S, MobilityOperator M>
+ContactSolveOutcome restart_from_crossing(ContactStep<S, M>& step, const VecX& lambda, double s, int before,
+                                          const DefectCorrectionOptions& options, const std::string& why) {
+  const VecX start = s * lambda;
+  ContactSolveOutcome out = solve_defect_correction_round(step, start, options, false);
+  const bool kept = out.converged && step.evaluate(out.lambda).min_distance() >= step.problem().d_hat &&
+                    out.lambda.sum() <= start.sum();
+  if (!kept) {
+    out.lambda = start;
+    out.converged = true;  // separated (the crossing), no force beyond the ray's smallest
+  }
+  out.iterations += before;
+  out.message = "default solver: " + why + ", first crossing of d_hat at " + std::to_string(s) + " x lambda" +
+                (kept ? ", polished" : "");
+  return out;
+}
+
 // One round from the warm start (the previous round's lambda, zero-padded).
 template <Shape S, MobilityOperator M>
-ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX lambda, const DefectCorrectionOptions& options) {
+ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX lambda,
+                                                  const DefectCorrectionOptions& options, bool search_rays) {
   ContactSolveOutcome out;
+  const double ray_tol = 1e-9;  // relative width of a crossing's bracket: the samples are cheap
+  int stalled = 0;
   const double d_hat = step.problem().d_hat, target = d_hat * (1.0 + options.margin);
   const double radius = step.options().cost == MobilityCost::formed
                             ? std::numeric_limits<double>::infinity()
@@ -154,7 +239,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
   MatX probed;  // positive_definite(probing.matrix()), recomputed when the working set grows
   double previous_shortfall = std::numeric_limits<double>::infinity();
   double best_shortfall = std::numeric_limits<double>::infinity();
-  VecX best_lambda = lambda;
+  VecX best_lambda = lambda, best_MD;  // best_MD: M D best_lambda
   int slow_corrections = 0;
   for (;;) {
     const ContactEvaluation& e = step.evaluate(lambda);
@@ -178,11 +263,28 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
     if (shortfall < best_shortfall) {
       best_shortfall = shortfall;
       best_lambda = lambda;
+      best_MD = e.MD_lambda;
     }
     // (With every probe a single contact the model is exact, and slowness is the geometry's.)
     const bool shared_probes = probing.probes() < static_cast<int>(probing.members().size());
     slow_corrections = shared_probes && shortfall > options.contraction * previous_shortfall ? slow_corrections + 1 : 0;
     if (slow_corrections == 2) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options);
+    // Corrections that stall with exact single-contact probes: the linear model points the
+    // wrong way (d falls along the force before it rises, non-convex contacts). The best ray is
+    // doubled until it separates (free, see above), then searched back for its first crossing.
+    stalled = !shared_probes && out.iterations > 0 && shortfall > options.contraction * previous_shortfall
+                  ? stalled + 1 : 0;
+    if (search_rays && stalled == options.stall_corrections && best_lambda.sum() > 0.0) {
+      const VecX& MD_best = best_MD;  // (evaluating best_lambda again would overwrite e)
+      for (double s_max = 2.0; s_max <= 1024.0; s_max *= 2.0)
+        if (min_flagged_distance_at(step, s_max * MD_best) >= target) {
+          if (const std::optional<double> s =
+                  ray_first_crossing(step, MD_best, s_max, target, 2 * options.ray_samples, ray_tol))
+            return restart_from_crossing(step, best_lambda, *s, out.iterations, options,
+                                         "corrections stalled " + std::to_string(stalled) + " times");
+          break;
+        }
+    }
     previous_shortfall = shortfall;
     VecX next;
     for (;;) {
@@ -213,6 +315,14 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
     const double change = (next - lambda).lpNorm<Eigen::Infinity>();
     const double scale = std::max(next.lpNorm<Eigen::Infinity>(), lambda.lpNorm<Eigen::Infinity>());
     if (e.min_distance() >= d_hat && change <= options.tol * scale) {  // Broms eq. 29 at a separated iterate
+      // A smaller separating force on the same ray (a far root of a non-monotone d): the
+      // samples before s = 1 only, so a monotone d costs them and nothing else.
+      if (search_rays && lambda.sum() > 0.0) {
+        const std::optional<double> s =
+            ray_first_crossing(step, e.MD_lambda, 1.0, target, options.ray_samples, ray_tol);
+        if (s && *s < 1.0 - 1.0 / options.ray_samples)
+          return restart_from_crossing(step, lambda, *s, out.iterations, options, "converged to a far root");
+      }
       out.converged = true;
       break;
     }
