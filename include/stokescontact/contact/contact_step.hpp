@@ -182,7 +182,7 @@ inline ContactPair carried_pair(const CarriedContact& c, Eigen::Index i, Eigen::
                                 std::span<const Pose> poses) {
   const Vec3 ci = poses[static_cast<std::size_t>(i)].to_world(c.curve_point_i);
   const Vec3 cj = shifted(poses[static_cast<std::size_t>(j)], image_shift).to_world(c.curve_point_j);
-  ContactPair p{i, j, image_shift, {}};
+  ContactPair p{i, j, image_shift, {}, std::nullopt};
   p.points.distance = c.normal.dot(cj - ci) - c.radius_i - c.radius_j;
   p.points.normal = c.normal;
   p.points.curve_point_a = ci;
