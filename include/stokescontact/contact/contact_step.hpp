@@ -325,9 +325,18 @@ class ContactStep {
   // Q(lambda) and the flagged-pair distances there; the last evaluation is cached.
   const ContactEvaluation& evaluate(const VecX& lambda) {
     if (last_ && last_->lambda.size() == lambda.size() && last_->lambda == lambda) return *last_;
-    ContactEvaluation e;
+    ContactEvaluation e = measure(MD_times(lambda));
     e.lambda = lambda;
-    e.MD_lambda = MD_times(lambda);
+    last_ = std::move(e);
+    return *last_;
+  }
+
+  // Q with velocities U + MD_lambda (M D lambda already known, e.g. scaled along a ray) and
+  // the flagged pairs measured there, as evaluate() does (carried contacts by their gap);
+  // no mobility application, nothing cached. `lambda` is left empty.
+  ContactEvaluation measure(VecX MD_lambda) const {
+    ContactEvaluation e;
+    e.MD_lambda = std::move(MD_lambda);
     e.poses = advance_all(problem_.poses, problem_.U + e.MD_lambda, dofs_, problem_.dt);  // eq. 13
     e.pairs.reserve(pairs_.size());
     e.distances.resize(nc());
@@ -339,8 +348,7 @@ class ContactStep {
                                                    problem_.box));
       e.distances(static_cast<Eigen::Index>(k)) = e.pairs.back().points.distance;
     }
-    last_ = std::move(e);
-    return *last_;
+    return e;
   }
 
   // The contact matrix of the flagged pairs at an evaluated configuration: D_k, with
@@ -485,7 +493,8 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   ContactSolveOutcome outcome;
   std::vector<ContactPair> violating;
   std::vector<TrajectoryCrossing> crossing;
-  const double overlap_tolerance = std::max(0.5 * options.separation_margin, 1e-6) * problem.d_hat;
+  // Overlaps deeper than separation_margin d_hat count, found within a tenth of that.
+  const double overlap_tolerance = std::max(0.1 * options.separation_margin, 1e-6) * problem.d_hat;
   for (int round = 0;; ++round) {
     const int iterations = r.iterations;
     outcome = solve(step, detail::padded(outcome.lambda, step.nc()));

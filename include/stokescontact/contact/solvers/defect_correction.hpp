@@ -142,13 +142,7 @@ inline std::optional<VecX> solve_working_set_lcp(const MatX& A, std::span<const 
 // (Broms eq. 13), given M D lambda: no mobility application.
 template <Shape S, MobilityOperator M>
 double min_flagged_distance_at(const ContactStep<S, M>& step, const VecX& MD_lambda) {
-  const ContactStepProblem<S>& p = step.problem();
-  const int dofs = static_cast<int>(p.U.size() / static_cast<Eigen::Index>(p.poses.size()));
-  const std::vector<Pose> poses = advance_all(p.poses, p.U + MD_lambda, dofs, p.dt);
-  double d = std::numeric_limits<double>::infinity();
-  for (const ContactPair& pair : step.pairs())
-    d = std::min(d, contact_pair(p.shapes, std::span<const Pose>(poses), pair.i, pair.j, p.box).points.distance);
-  return d;
+  return step.measure(MD_lambda).min_distance();
 }
 
 // The first crossing of the target by the flagged distances on the ray s lambda, s in (0, s_max],
