@@ -205,8 +205,7 @@ std::vector<sc::Pose> jittered_lattice(std::size_t n, double phi, sc::Rng& rng) 
 }
 
 void overhead(ex::JsonLines& sink, const std::vector<std::size_t>& sizes, int repeats) {
-  std::fprintf(stderr,
-               "\nDetection cost: jittered lattice phi 0.3, |f| = 100, free draining, dt = d_hat = 0.01 (median of %d)\n"
+  std::printf("\nDetection cost: jittered lattice phi 0.3, |f| = 100, free draining, dt = d_hat = 0.01 (median of %d)\n"
                "%8s | %10s | %10s %10s %10s | %10s %10s | %6s %6s | %10s %6s\n",
                repeats, "N", "U and Q*", "eq31 pairs", "rel pairs", "interior", "step end", "step whole", "Nc", "extra",
                "RPY apply", "extra");
