@@ -55,6 +55,26 @@ inline Vec3 mean_velocity(const VecX& U, std::size_t bodies, int dofs_per_body) 
   return bodies == 0 ? sum : Vec3(sum / static_cast<double>(bodies));
 }
 
+// The broad phase's input for a motion with velocities V: centres, bounding radii (to be grown
+// by the caller), the largest bounding radius, each body's velocity and the mean velocity.
+template <Shape S>
+struct SweptBodies {
+  Mat3X centres;
+  VecX radii;
+  double body_radius = 0.0;
+  std::vector<RigidVelocity> v;
+  Vec3 mean = Vec3::Zero();
+
+  SweptBodies(std::span<const S> shapes, std::span<const Pose> poses, const VecX& V, int dofs_per_body) {
+    validate_scene(shapes, poses);
+    require_velocities(V, poses.size(), dofs_per_body);
+    mean = mean_velocity(V, poses.size(), dofs_per_body);
+    broad_phase_input(shapes, poses, centres, radii);
+    body_radius = radii.size() > 0 ? radii.maxCoeff() : 0.0;
+    for (std::size_t k = 0; k < poses.size(); ++k) v.push_back(rigid_velocity(V, k, dofs_per_body));
+  }
+};
+
 // Candidate pairs (i < j, sorted) of balls grown by each body's motion over the step. A few
 // fast bodies would set the cell size for everyone (cells are 2 max radius + cutoff wide):
 // balls more than twice the largest body's own bounding radius are tested against every
@@ -97,25 +117,17 @@ template <Shape S>
 RelativePairs find_pairs_relative(std::span<const S> shapes, std::span<const Pose> trial, const VecX& U,
                                   int dofs_per_body, double dt, double d_hat, double multiplier,
                                   const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
-  validate_scene(shapes, trial);
-  detail::require_velocities(U, trial.size(), dofs_per_body);
+  detail::SweptBodies<S> b(shapes, trial, U, dofs_per_body);
   detail::d_try_from_speed(d_hat, dt, 0.0, multiplier);  // checks d_hat, dt, multiplier
-  const std::size_t n = trial.size();
-  const Vec3 mean = detail::mean_velocity(U, n, dofs_per_body);
-  Mat3X centres;
-  VecX radii;
-  detail::broad_phase_input(shapes, trial, centres, radii);
-  const double body_radius = radii.size() > 0 ? radii.maxCoeff() : 0.0;
-  std::vector<RigidVelocity> v(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    v[k] = rigid_velocity(U, k, dofs_per_body);
-    const double own = (v[k].u - mean).norm() + v[k].omega.norm() * centre_curve_reach(shape_of(shapes, k));
-    radii[static_cast<Eigen::Index>(k)] += multiplier * dt * own;
+  const std::vector<RigidVelocity>& v = b.v;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const double own = (v[k].u - b.mean).norm() + v[k].omega.norm() * centre_curve_reach(shape_of(shapes, k));
+    b.radii[static_cast<Eigen::Index>(k)] += multiplier * dt * own;
   }
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
   RelativePairs out;
-  for (const BodyPair& c : detail::swept_candidates(centres, radii, body_radius, multiplier * d_hat, box, list)) {
+  for (const BodyPair& c : detail::swept_candidates(b.centres, b.radii, b.body_radius, multiplier * d_hat, box, list)) {
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const S& si = shape_of(shapes, i);
     const S& sj = shape_of(shapes, j);
@@ -145,31 +157,23 @@ std::vector<TrajectoryCrossing> trajectory_crossings(std::span<const S> shapes, 
                                                      const VecX& V, int dofs_per_body, double dt, double threshold,
                                                      double tolerance, const std::optional<PeriodicBox>& box = {},
                                                      CellList* cells = nullptr) {
-  validate_scene(shapes, poses);
-  detail::require_velocities(V, poses.size(), dofs_per_body);
+  detail::SweptBodies<S> b(shapes, poses, V, dofs_per_body);
   require_positive(dt, "dt");
   require_finite(threshold, "threshold");
   require_positive(tolerance, "tolerance");
-  const std::size_t n = poses.size();
-  const Vec3 mean = detail::mean_velocity(V, n, dofs_per_body);
-  Mat3X centres;
-  VecX radii;
-  detail::broad_phase_input(shapes, poses, centres, radii);
-  const double body_radius = radii.size() > 0 ? radii.maxCoeff() : 0.0;
-  std::vector<RigidVelocity> v(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    v[k] = rigid_velocity(V, k, dofs_per_body);
-    const Vec3 drift = 0.5 * dt * (v[k].u - mean);
-    centres.col(static_cast<Eigen::Index>(k)) += drift;
-    radii[static_cast<Eigen::Index>(k)] += drift.norm();
+  const std::vector<RigidVelocity>& v = b.v;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const Vec3 drift = 0.5 * dt * (v[k].u - b.mean);
+    b.centres.col(static_cast<Eigen::Index>(k)) += drift;
+    b.radii[static_cast<Eigen::Index>(k)] += drift.norm();
   }
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
   std::vector<TrajectoryCrossing> out;
   const double cutoff = std::max(0.0, threshold) + tolerance;
-  for (const BodyPair& c : detail::swept_candidates(centres, radii, body_radius, cutoff, box, list)) {
+  for (const BodyPair& c : detail::swept_candidates(b.centres, b.radii, b.body_radius, cutoff, box, list)) {
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
-    const Vec3 shift = minimum_image_shift(centres.col(c.i), centres.col(c.j), box);
+    const Vec3 shift = minimum_image_shift(b.centres.col(c.i), b.centres.col(c.j), box);
     SweptDistance first = first_time_below(shape_of(shapes, i), poses[i], v[i], shape_of(shapes, j),
                                            shifted(poses[j], shift), v[j], dt, threshold, tolerance);
     if (first.below) out.push_back({c.i, c.j, shift, std::move(first)});
