@@ -81,5 +81,7 @@
 #include "stokescontact/dynamics/time_stepper.hpp"
 
 // io
+#include "stokescontact/io/body_mesh.hpp"
 #include "stokescontact/io/diagnostics_json.hpp"
 #include "stokescontact/io/json.hpp"
+#include "stokescontact/io/vtk_polydata.hpp"
