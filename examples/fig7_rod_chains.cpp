@@ -9,7 +9,11 @@
 //
 //   fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat 1e-4,3e-4,...,1e-1]
 //                   [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
-//                   [--directions particle|surface|line] [--output FILE]
+//                   [--directions particle|surface|line] [--output FILE] [--scene FILE]
+//
+// --scene FILE writes the first chain at the first d_hat as a scene file for stokescontact-run
+// (its poses, the pushes as per-body forces, one step; docs/scenes.md) and runs nothing else:
+// examples/scenes/rod_chain.json is `fig7_rod_chains --d-hat 1e-2 --scene FILE`.
 //
 // Per chain one JSON object with, per consecutive pair, d at the trial step Q* (no contact
 // forces) and after, and per flagged pair lambda / |f| (the net contact force over the push);
@@ -41,7 +45,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat LIST] [--solver NAME]\n"
     "                       [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
-    "                       [--directions particle|surface|line] [--output FILE]\n";
+    "                       [--directions particle|surface|line] [--output FILE] [--scene FILE]\n";
 
 constexpr double kLRod = 0.5, kRRod = kLRod / 20.0, kDt = 0.05;  // Sec. 3.2.2
 
@@ -55,6 +59,7 @@ struct Options {
   int blobs_per_ring = 8;
   ex::RodDirections directions = ex::RodDirections::particle;
   std::string output;
+  std::string scene;
 };
 
 Options parse(int argc, char** argv) {
@@ -69,6 +74,7 @@ Options parse(int argc, char** argv) {
   o.blobs_per_ring = static_cast<int>(args.integer("--blobs-per-ring", 8, 3));
   o.directions = ex::parse_directions(args.text("--directions", "particle"));
   o.output = args.text("--output", "");
+  o.scene = args.text("--scene", "");
   args.reject_unknown();
   return o;
 }
@@ -192,6 +198,40 @@ void run_d_hat(const Options& o, const S& rod, double d_hat, M& mobility, ex::Js
   }
 }
 
+// The first chain at d_hat as a scene file: its poses, the pushes as per-body forces, one step.
+void write_scene(const Options& o, double d_hat) {
+  const sc::Spherocylinder rod = ex::paper_rod(kLRod, kRRod);
+  std::mt19937_64 rng(o.seed);
+  const Chain c = make_chain(rod, o.rods, d_hat, rng);
+  const double f = 2.0 * std::cbrt(d_hat);
+  std::string poses, forces;
+  for (int k = 0; k < o.rods; ++k) {
+    const sc::Pose& p = c.poses[static_cast<std::size_t>(k)];
+    const sc::Vec3 push = k + 1 < o.rods ? sc::Vec3(f * (c.poses[static_cast<std::size_t>(k + 1)].x - p.x).normalized())
+                                         : sc::Vec3::Zero();
+    const double q[4] = {p.q.w(), p.q.x(), p.q.y(), p.q.z()};
+    poses += std::string(k ? ",\n      " : "") + "{\"position\": " + sc::json_array(p.x) +
+             ", \"orientation\": " + sc::json_array(std::span<const double>(q, 4)) + "}";
+    forces += std::string(k ? ",\n      " : "") + sc::json_array(push);
+  }
+  std::FILE* out = std::fopen(o.scene.c_str(), "w");
+  if (!out) throw std::runtime_error("cannot write " + o.scene);
+  std::fprintf(out,
+               "{\n  \"name\": \"rod_chain\",\n  \"description\": \"Broms & Tornberg Fig. 7: a chain of %d rods "
+               "(L_rod = 0.5, R_rod = L_rod / 20), consecutive gaps d_hat = %g, each rod pushed towards the next with "
+               "|f| = 2 d_hat^(1/3); one step of dt 0.05 (fig7_rod_chains --seed %llu --d-hat %g --scene FILE)\",\n"
+               "  \"shape\": {\"type\": \"spherocylinder\", \"length\": %s, \"radius\": %s},\n"
+               "  \"bodies\": {\"poses\": [\n      %s]},\n"
+               "  \"forces\": {\"type\": \"per_body\", \"force\": [\n      %s]},\n"
+               "  \"mobility\": {\"model\": \"free-draining\"},\n"
+               "  \"contact\": {\"d_hat\": %s},\n  \"time\": {\"dt\": %s, \"steps\": 1}\n}\n",
+               o.rods, d_hat, static_cast<unsigned long long>(o.seed), d_hat, sc::json_number(rod.length).c_str(),
+               sc::json_number(rod.radius).c_str(), poses.c_str(), forces.c_str(), sc::json_number(d_hat).c_str(),
+               sc::json_number(kDt).c_str());
+  std::fclose(out);
+  std::printf("fig7_rod_chains: chain of %d rods at d_hat %g -> %s\n", o.rods, d_hat, o.scene.c_str());
+}
+
 template <sc::MobilityOperator M>
 void run_all(const Options& o, M& mobility) {
   ex::JsonLines sink(o.output);
@@ -236,6 +276,10 @@ int main(int argc, char** argv) {
   return ex::driver_main(
       "fig7_rod_chains", kUsage, [&] { o = parse(argc, argv); },
       [&] {
+        if (!o.scene.empty()) {
+          write_scene(o, o.d_hats.front());
+          return;
+        }
         ex::RodMobility mobility = ex::make_rod_mobility(o.mobility, ex::paper_rod(kLRod, kRRod),
                                                           static_cast<std::size_t>(o.rods), o.blobs_per_ring);
         std::visit([&](auto& m) { run_all(o, m); }, mobility);

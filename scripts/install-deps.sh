@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages StokesContact needs, only those that are missing.
 set -euo pipefail
-# python3-vtk9: the test vtk_readback reads the VTK output back with VTK's own reader.
-packages=(g++ cmake make libeigen3-dev libnlopt-cxx-dev libgtest-dev libbenchmark-dev python3-vtk9)
+# nlohmann-json3-dev: scene files (stokescontact-run); python3-vtk9: the test vtk_readback reads
+# the VTK output back with VTK's own reader.
+packages=(g++ cmake make libeigen3-dev libnlopt-cxx-dev libgtest-dev libbenchmark-dev
+          nlohmann-json3-dev python3-vtk9)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

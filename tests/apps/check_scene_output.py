@@ -1,0 +1,87 @@
+#!/usr/bin/python3
+"""Runs a scene through stokescontact-run and reads what it wrote back independently.
+
+    /usr/bin/python3 tests/apps/check_scene_output.py RUNNER SCENE.json OUT_DIR MAX_STEPS
+
+The summary (summary.json) and the step log (steps.jsonl, one object per step, steps 1..n,
+times n dt) agree with each other and with the scene; the VTK series (bodies.pvd, read with
+xml.etree, and each frame with VTK's own vtkXMLPolyDataReader) lists frames at increasing
+times equal to the .pvd timesteps, every frame holds the scene's bodies (body_id 0..N-1 on the
+points, one centre and one unit quaternion per body in the FieldData), rods' axes are their
+quaternion applied to e_z, and the last frame is at the run's final time. Exits 1 with the
+failures listed.
+"""
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+
+runner, scene_file, out_dir, max_steps = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+failures = []
+
+
+def check(condition, message):
+    if not condition:
+        failures.append(message)
+
+
+shutil.rmtree(out_dir, ignore_errors=True)
+run = subprocess.run([runner, scene_file, "--output", out_dir, "--max-steps", str(max_steps), "--quiet"],
+                     capture_output=True, text=True)
+print(run.stdout)
+if run.returncode != 0:
+    sys.exit("runner failed (%d): %s" % (run.returncode, run.stderr))
+
+scene = json.load(open(scene_file))
+summary = json.load(open(os.path.join(out_dir, "summary.json")))
+dt = scene["time"]["dt"]
+steps = [json.loads(line) for line in open(os.path.join(out_dir, "steps.jsonl"))]
+check(len(steps) == summary["steps_done"] == max_steps, "steps: %d lines, summary %d, asked %d"
+      % (len(steps), summary["steps_done"], max_steps))
+for k, s in enumerate(steps):
+    check(s["step"] == k + 1, "step %d numbered %d" % (k + 1, s["step"]))
+    check(math.isclose(s["time"], (k + 1) * dt, rel_tol=1e-12), "step %d at t %g" % (k + 1, s["time"]))
+check(summary["applications_total"] == sum(s["mobility_applications"] for s in steps),
+      "summary's applications differ from the step log's sum")
+check(math.isclose(summary["min_distance_ratio"], min(s["min_distance_ratio"] for s in steps), rel_tol=1e-12),
+      "summary's min d / d_hat differs from the step log's")
+check(summary["min_distance_ratio"] >= 1 - 1e-3, "min d / d_hat %g below the margin" % summary["min_distance_ratio"])
+
+pvd = ET.parse(os.path.join(out_dir, "bodies.pvd")).getroot()
+frames = [(float(d.get("timestep")), d.get("file")) for d in pvd.iter("DataSet")]
+check(len(frames) == summary["frames"], "pvd lists %d frames, summary %d" % (len(frames), summary["frames"]))
+check(all(a[0] < b[0] for a, b in zip(frames, frames[1:])), "frame times do not increase")
+check(math.isclose(frames[-1][0], summary["time"], rel_tol=1e-12), "last frame at %g, run ended at %g"
+      % (frames[-1][0], summary["time"]))
+bodies = summary["bodies"]
+for time, name in frames:
+    reader = vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(os.path.join(out_dir, name))
+    reader.Update()
+    poly = reader.GetOutput()
+    check(poly.GetNumberOfPoints() > 0 and poly.GetNumberOfPolys() > 0, "%s: no mesh" % name)
+    ids = vtk_to_numpy(poly.GetPointData().GetArray("body_id"))
+    check(sorted(set(ids.tolist())) == list(range(bodies)), "%s: body ids are not 0..%d" % (name, bodies - 1))
+    fd = poly.GetFieldData()
+    check(math.isclose(fd.GetArray("TIME").GetValue(0), time, rel_tol=1e-12), "%s: TIME differs from the pvd" % name)
+    centres = vtk_to_numpy(fd.GetArray("centre"))
+    quats = vtk_to_numpy(fd.GetArray("orientation_quaternion"))
+    axes = vtk_to_numpy(fd.GetArray("axis"))
+    check(centres.shape == (bodies, 3) and quats.shape == (bodies, 4), "%s: per-body field data sizes" % name)
+    for k in range(bodies):
+        w, x, y, z = quats[k]
+        check(abs(w * w + x * x + y * y + z * z - 1) < 1e-9, "%s: body %d quaternion not unit" % (name, k))
+        # R e_z for q = (w, x, y, z)
+        ez = (2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y))
+        check(all(abs(a - b) < 1e-9 for a, b in zip(ez, axes[k])), "%s: body %d axis is not q e_z" % (name, k))
+
+if failures:
+    print("\n".join(failures[:20]))
+    sys.exit(1)
+print("check_scene_output: %d steps, %d frames of %d bodies read back" % (len(steps), len(frames), bodies))
