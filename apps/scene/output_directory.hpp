@@ -13,8 +13,9 @@ namespace stokescontact::apps {
 
 class OutputDirectory {
  public:
-  // Checks only; creates nothing.
-  OutputDirectory(std::filesystem::path final_dir, bool replace)
+  // Checks only; creates nothing. `create_parent`: a missing parent directory is made at
+  // open() (the default out/<name>); otherwise it must exist.
+  OutputDirectory(std::filesystem::path final_dir, bool replace, bool create_parent = false)
       : final_(std::move(final_dir)), partial_(final_.string() + ".partial"), replace_(replace) {
     if (final_.empty()) throw SceneError("--output", "must name a directory");
     if (std::filesystem::exists(final_) && !replace_)
@@ -24,12 +25,13 @@ class OutputDirectory {
     if (std::filesystem::exists(final_) && !std::filesystem::is_directory(final_))
       throw SceneError("--output", "'" + final_.string() + "' exists and is not a directory");
     const std::filesystem::path parent = std::filesystem::absolute(final_).parent_path();
-    if (!std::filesystem::is_directory(parent))
+    if (!create_parent && !std::filesystem::is_directory(parent))
       throw SceneError("--output", "the parent directory '" + parent.string() + "' does not exist");
   }
 
   // Creates `<dir>.partial` (a leftover of an earlier interrupted run is removed first).
   const std::filesystem::path& open() {
+    std::filesystem::create_directories(std::filesystem::absolute(final_).parent_path());
     std::filesystem::remove_all(partial_);
     std::filesystem::create_directory(partial_);
     return partial_;

@@ -179,7 +179,9 @@ RunSummary run_shape(const SceneSpec& spec, const nlohmann::json& document, cons
   if (spec.contact.d_try > 0.0 && spec.contact.d_try < d_hat)
     throw SceneError("contact.d_try", "must be 0 (the d_try rule) or >= d_hat = " + JsonReader::format(d_hat));
   const ModelChoice choice = choose_model(spec, d_hat / contact_radius(shape));
-  OutputDirectory output(run.output.empty() ? std::filesystem::path("out") / spec.name : run.output, run.replace);
+  const bool default_output = run.output.empty();
+  OutputDirectory output(default_output ? std::filesystem::path("out") / spec.name : run.output, run.replace,
+                         /*create_parent=*/default_output);
   SceneMobility mobility = make_mobility(choice, spec.mobility, shape, poses.size());
 
   summary.bodies = poses.size();

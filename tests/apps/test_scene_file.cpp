@@ -275,3 +275,16 @@ TEST(SceneRun, AnEarlierRunIsRefusedOrReplacedWhole) {
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "summary.json"));
   std::filesystem::remove_all(dir);
 }
+
+TEST(SceneRun, DefaultOutputIsOutSlashNameMadeWhenMissing) {
+  const std::filesystem::path dir = scratch("default_output");
+  const std::filesystem::path scene = write_scene(dir, two_spheres());
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  apps::RunSummary s;
+  EXPECT_NO_THROW(s = run(scene, ""));
+  std::filesystem::current_path(cwd);
+  EXPECT_EQ(s.status, "finished");
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "two_spheres" / "summary.json"));
+  std::filesystem::remove_all(dir);
+}

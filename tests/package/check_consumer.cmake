@@ -35,3 +35,9 @@ run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/package/consumer -B ${WORK_DIR}
          -DCMAKE_BUILD_TYPE=Release -DEXPECT_NLOPT=${expect})
 run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run_step(${WORK_DIR}/build/consumer)
+# The runner is installed with the package (built with NLopt, as the project's own build is):
+# it runs an example scene from the prefix for two steps.
+if(NLOPT)
+  run_step(${prefix}/bin/stokescontact-run ${SOURCE_DIR}/examples/scenes/biaxial_rods.json
+           --output ${WORK_DIR}/run --max-steps 2 --quiet)
+endif()
