@@ -3,6 +3,7 @@
 // Umbrella header: includes every public header, layer by layer.
 
 // core
+#include "stokescontact/core/block_average.hpp"
 #include "stokescontact/core/errors.hpp"
 #include "stokescontact/core/gaussian_stream.hpp"
 #include "stokescontact/core/gmres.hpp"
@@ -77,6 +78,7 @@
 
 // dynamics
 #include "stokescontact/dynamics/background_flow.hpp"
+#include "stokescontact/dynamics/collision_stress.hpp"
 #include "stokescontact/dynamics/step_diagnostics.hpp"
 #include "stokescontact/dynamics/time_stepper.hpp"
 

@@ -139,6 +139,9 @@ struct ContactStepResult {
   VecX lambda;                          // contact magnitudes, one per flagged pair, >= 0
   std::vector<ContactPair> pairs;       // the flagged pairs at Q* (missed ones appended)
   VecX contact_forces;                  // D lambda: forces (and torques) per body
+  // The columns of D at Q*, one per pair (D = assemble_contact_matrix(columns, N, dofs)):
+  // where each pair's force acts, for the collision stress (dynamics/collision_stress.hpp).
+  std::vector<ContactColumn> columns;
   VecX velocities;                      // U + M D lambda
   std::vector<Pose> poses;              // Q(lambda), the new configuration
   int iterations = 0;                   // solver iterations over all rounds (see each solver)
@@ -369,6 +372,7 @@ class ContactStep {
   }
   int dofs_per_body() const { return dofs_; }
   const Eigen::SparseMatrix<double>& D() const { return D_; }
+  const std::vector<ContactColumn>& columns() const { return columns_; }  // D's, one per pair
   const std::vector<ContactPair>& pairs() const { return pairs_; }
   const ContactStepProblem<S>& problem() const { return problem_; }
   const ContactStepOptions& options() const { return options_; }
@@ -403,6 +407,7 @@ class ContactStep {
           detail::surface_contact_column(contact, trial, *weight_barrier, options_.surface_weights, field));
     }
     D_ = assemble_contact_matrix(columns, trial_.size(), dofs_);
+    columns_ = std::move(columns);
   }
 
   // Flagged pair k passes through or sweeps past in the trial step when its distance along
@@ -458,6 +463,7 @@ class ContactStep {
   std::vector<std::optional<CarriedContact>> carried_;  // per pair: carried or not
   std::vector<SurfaceNodes> nodes_;  // per shape, for d^S directions (empty: d^P)
   Eigen::SparseMatrix<double> D_;
+  std::vector<ContactColumn> columns_;  // D_'s columns
   std::vector<VecX> MD_columns_;  // the columns of M D formed so far (empty: not yet)
   std::optional<ContactEvaluation> last_;
 };
@@ -527,6 +533,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   r.flagged_pairs = r.pairs.size();
   r.carried_pairs = step.carried_count();
   r.contact_forces = step.D() * r.lambda;
+  r.columns = step.columns();
   r.velocities = problem.U + e.MD_lambda;
   r.poses = e.poses;
   r.d_try = step.d_try();

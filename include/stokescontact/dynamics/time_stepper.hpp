@@ -9,6 +9,11 @@
 //      (positions only: the contact code measures pairs by minimum image);
 //   4. the step's StepDiagnostics and Q_{t+dt} go to every step observer (JSON lines through
 //      io/diagnostics_json.hpp, trajectories, statistics: whatever the caller attaches).
+// Contact observers (add_contact_observer) get each contact step's problem and result, e.g.
+// for the collision stress (dynamics/collision_stress.hpp): once per committed contact
+// sub-step, in time order (problem.dt is the sub-step's length, problem.poses its start),
+// after the step has committed and before the step observers. Attempts that failed and were
+// sub-stepped are never reported; the results are kept only while contact observers exist.
 // A background flow with a periodic box is refused: u = E x is not periodic, and
 // Lees-Edwards boundary conditions are not implemented.
 //
@@ -79,6 +84,11 @@ using ExternalForceField = std::function<VecX(double, std::span<const Pose>)>;
 // the box); the span is valid during the call only.
 using StepObserver = std::function<void(const StepDiagnostics&, std::span<const Pose>)>;
 
+// Called for every contact sub-step of a committed step with its problem (spans valid during
+// the call only) and result.
+template <Shape S>
+using ContactObserver = std::function<void(const ContactStepProblem<S>&, const ContactStepResult&)>;
+
 template <Shape S, MobilityOperator M>
 class TimeStepper {
  public:
@@ -133,6 +143,15 @@ class TimeStepper {
 
   void clear_step_observers() { observers_.clear(); }
 
+  // Contact observers run after every committed step, once per contact sub-step that step
+  // is made of (in time order), before the step observers; in the order added.
+  void add_contact_observer(ContactObserver<S> observer) {
+    if (!observer) fail_argument("contact_observer", "must be callable");
+    contact_observers_.push_back(std::move(observer));
+  }
+
+  void clear_contact_observers() { contact_observers_.clear(); }
+
   // One step; returns its diagnostics (also kept in diagnostics()). Throws std::runtime_error
   // on failed separation.
   StepDiagnostics step() {
@@ -142,6 +161,7 @@ class TimeStepper {
     d.substeps = 0;
     d.min_distance_ratio = std::numeric_limits<double>::infinity();
     std::string failure;
+    pending_.clear();
     if (!advance_interval(poses, time_, options_.dt, 0, d, failure))
       throw std::runtime_error("time step " + std::to_string(steps_ + 1) + " from t = " + std::to_string(time_) +
                                ": " + failure);
@@ -154,6 +174,12 @@ class TimeStepper {
     d.time = time_;
     d.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     diagnostics_.push_back(std::move(d));
+    std::vector<PendingContactStep> committed = std::move(pending_);
+    pending_.clear();
+    for (const PendingContactStep& c : committed) {
+      const ContactStepProblem<S> problem = make_problem(std::span<const Pose>(c.poses), c.U, c.dt);
+      for (const ContactObserver<S>& observer : contact_observers_) observer(problem, c.result);
+    }
     for (const StepObserver& observer : observers_) observer(diagnostics_.back(), std::span<const Pose>(poses_));
     return diagnostics_.back();
   }
@@ -217,9 +243,7 @@ class TimeStepper {
       applications = 1;
     }
     // Eq. 13/16 through the chosen solver.
-    ContactStepProblem<S> problem{std::span<const S>(shapes_), q_t, U, h, options_.d_hat,
-                                  options_.d_try,              options_.d_try_multiplier, options_.box};
-    problem.d_try_rule = options_.d_try_rule;
+    const ContactStepProblem<S> problem = make_problem(q_t, U, h);
     ContactStepResult result = solve(problem);
     d.unconstrained_applications += applications;
     d.mobility_applications += applications + result.mobility_applications;
@@ -227,12 +251,16 @@ class TimeStepper {
     if (result.status == ContactStepStatus::failed_separation) {
       failure = result.message;
       if (halvings >= options_.max_substep_halvings) return false;
+      // Halves: nothing was recorded for this attempt, and each half records its own.
       return advance_interval(poses, t, 0.5 * h, halvings + 1, d, failure) &&
              advance_interval(poses, t + 0.5 * h, 0.5 * h, halvings + 1, d, failure);
     }
     if (result.poses.size() != poses.size())
       throw std::runtime_error("contact solver returned " + std::to_string(result.poses.size()) + " poses for " +
                                std::to_string(poses.size()) + " bodies");
+    // Kept for the contact observers until the step commits (a sub-step of a step that fails
+    // later is dropped with it: step() clears pending_ first).
+    if (!contact_observers_.empty()) pending_.push_back({std::vector<Pose>(q_t.begin(), q_t.end()), U, h, result});
     poses = std::move(result.poses);
     ++d.substeps;
     d.flagged_pairs = std::max(d.flagged_pairs, result.flagged_pairs);
@@ -246,6 +274,14 @@ class TimeStepper {
     d.lambda_sum += result.lambda_sum;
     d.lambda_max = std::max(d.lambda_max, result.lambda_max);
     return true;
+  }
+
+  // The contact step of an interval of length h from q_t with velocities U.
+  ContactStepProblem<S> make_problem(std::span<const Pose> q_t, const VecX& U, double h) const {
+    ContactStepProblem<S> problem{std::span<const S>(shapes_), q_t, U, h, options_.d_hat,
+                                  options_.d_try,              options_.d_try_multiplier, options_.box};
+    problem.d_try_rule = options_.d_try_rule;
+    return problem;
   }
 
   ContactStepResult solve(const ContactStepProblem<S>& problem) {
@@ -274,6 +310,15 @@ class TimeStepper {
   std::optional<VecX> forces_;
   ExternalForceField force_field_;
   std::vector<StepObserver> observers_;
+  // A contact sub-step of the step in progress, for the contact observers.
+  struct PendingContactStep {
+    std::vector<Pose> poses;  // its Q_t
+    VecX U;
+    double dt = 0.0;
+    ContactStepResult result;
+  };
+  std::vector<ContactObserver<S>> contact_observers_;
+  std::vector<PendingContactStep> pending_;
   std::vector<StepDiagnostics> diagnostics_;
 };
 
