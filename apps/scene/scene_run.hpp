@@ -14,6 +14,7 @@
 #include <iostream>
 #include <limits>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -44,6 +45,14 @@ struct RunSummary {
   long long min_distance_step = 0;
   std::size_t applications_total = 0, applications_median = 0, applications_max = 0;
   double wall_time_s = 0.0;
+  // The collision stress per step (Yan eq. 16 summed over the step's pairs: force x length,
+  // not divided by a volume), averaged over the run with block-averaging error bars
+  // (core/block_average.hpp); NaN with fewer than 2 steps.
+  Mat3 collision_stress_mean = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());
+  Mat3 collision_stress_error = Mat3::Constant(std::numeric_limits<double>::quiet_NaN());
+  double collision_pressure_mean = std::numeric_limits<double>::quiet_NaN();
+  double collision_pressure_error = std::numeric_limits<double>::quiet_NaN();
+  bool collision_pressure_error_converged = false;
   std::filesystem::path output;
 
   std::string json() const {
@@ -60,7 +69,17 @@ struct RunSummary {
            ", \"applications_total\": " + std::to_string(applications_total) +
            ", \"applications_median\": " + std::to_string(applications_median) +
            ", \"applications_max\": " + std::to_string(applications_max) + ", \"wall_time_s\": " + json_number(wall_time_s) +
-           ", \"frames\": " + std::to_string(frames) + "}";
+           ", \"frames\": " + std::to_string(frames) + ", \"collision_stress_mean\": " + row_major(collision_stress_mean) +
+           ", \"collision_stress_error\": " + row_major(collision_stress_error) +
+           ", \"collision_pressure_mean\": " + json_number(collision_pressure_mean) +
+           ", \"collision_pressure_error\": " + json_number(collision_pressure_error) +
+           ", \"collision_pressure_error_converged\": " + (collision_pressure_error_converged ? "true" : "false") + "}";
+  }
+
+ private:
+  static std::string row_major(const Mat3& m) {
+    const Mat3 t = m.transpose();
+    return json_array(std::span<const double>(t.data(), 9));
   }
 };
 

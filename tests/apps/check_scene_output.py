@@ -8,7 +8,9 @@ times n dt) agree with each other and with the scene; the VTK series (bodies.pvd
 xml.etree, and each frame with VTK's own vtkXMLPolyDataReader) lists frames at increasing
 times equal to the .pvd timesteps, every frame holds the scene's bodies (body_id 0..N-1 on the
 points, one centre and one unit quaternion per body in the FieldData), rods' axes are their
-quaternion applied to e_z, and the last frame is at the run's final time. Exits 1 with the
+quaternion applied to e_z, the last frame is at the run's final time, and the collision stress log (stress.jsonl) has a
+symmetric tensor with pressure trace / 3 each step, nonzero exactly when pairs pushed, whose
+mean is the summary's. Exits 1 with the
 failures listed.
 """
 import json
@@ -52,6 +54,21 @@ check(summary["applications_total"] == sum(s["mobility_applications"] for s in s
 check(math.isclose(summary["min_distance_ratio"], min(s["min_distance_ratio"] for s in steps), rel_tol=1e-12),
       "summary's min d / d_hat differs from the step log's")
 check(summary["min_distance_ratio"] >= 1 - 1e-3, "min d / d_hat %g below the margin" % summary["min_distance_ratio"])
+
+stress = [json.loads(line) for line in open(os.path.join(out_dir, "stress.jsonl"))]
+check(len(stress) == len(steps), "stress.jsonl has %d lines for %d steps" % (len(stress), len(steps)))
+for k, s in enumerate(stress):
+    check(s["step"] == k + 1, "stress line %d numbered %d" % (k + 1, s["step"]))
+    sigma = s["collision_stress"]
+    check(math.isclose(s["collision_pressure"], (sigma[0] + sigma[4] + sigma[8]) / 3, rel_tol=1e-12, abs_tol=1e-300),
+          "step %d: collision pressure is not trace / 3" % (k + 1))
+    check(all(abs(sigma[3 * i + j] - sigma[3 * j + i]) <= 1e-9 * max(1.0, max(map(abs, sigma)))
+              for i in range(3) for j in range(3)), "step %d: frictionless collision stress not symmetric" % (k + 1))
+    check((sum(map(abs, sigma)) > 0) == (steps[k]["active_pairs"] > 0),
+          "step %d: stress %s with %d active pairs" % (k + 1, sigma, steps[k]["active_pairs"]))
+mean_pressure = sum(s["collision_pressure"] for s in stress) / len(stress)
+check(math.isclose(summary["collision_pressure_mean"], mean_pressure, rel_tol=1e-9),
+      "summary's collision pressure %g is not the mean %g of the steps'" % (summary["collision_pressure_mean"], mean_pressure))
 
 pvd = ET.parse(os.path.join(out_dir, "bodies.pvd")).getroot()
 frames = [(float(d.get("timestep")), d.get("file")) for d in pvd.iter("DataSet")]

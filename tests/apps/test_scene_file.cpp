@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -222,6 +223,22 @@ TEST(SceneRun, ContactHoldsTheGapOverALongRun) {
   EXPECT_GT(s.contact_steps, 40);
   EXPECT_GE(s.min_distance_ratio, 1.0 - 1e-3);
   EXPECT_LE(s.min_distance_ratio, 1.0 + 1e-2);  // pushed together: held at d_hat
+  // The last step's collision stress (stress.jsonl) by hand: body 1 gets -lambda e_x from the
+  // contact, and D is built at the trial step, whose centre distance is the start's 2 + d_hat
+  // (held to the solver's 1e-4) less dt times the closing speed 2 x 10 / (6 pi), so Yan's
+  // eq. 19 gives sigma_xx = lambda (2 + d_hat - dt 20 / (6 pi)), every other entry 0.
+  std::string line, last_step, last_stress;
+  for (std::ifstream in(dir / "out" / "steps.jsonl"); std::getline(in, line);) last_step = line;
+  for (std::ifstream in(dir / "out" / "stress.jsonl"); std::getline(in, line);) last_stress = line;
+  const double lambda = json::parse(last_step)["lambda_sum"];
+  const json stress = json::parse(last_stress);
+  EXPECT_NEAR(lambda, 10.0, 1e-3);
+  const double expected = lambda * (2.0 + 0.05 - 0.01 * 20.0 / (6.0 * std::numbers::pi));
+  EXPECT_NEAR(stress["collision_stress"][0].get<double>(), expected, 1e-4 * expected);
+  for (int k = 1; k < 9; ++k) EXPECT_EQ(stress["collision_stress"][k].get<double>(), 0.0) << k;
+  EXPECT_NEAR(stress["collision_pressure"].get<double>(), expected / 3.0, 1e-4 * expected);
+  EXPECT_GT(s.collision_pressure_mean, 0.0);
+  EXPECT_GT(s.collision_pressure_error, 0.0);
   std::filesystem::remove_all(dir);
 }
 
