@@ -9,7 +9,7 @@
 //
 //   fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat 1e-4,3e-4,...,1e-1]
 //                   [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
-//                   [--directions particle|surface|line] [--output FILE] [--scene FILE]
+//                   [--directions particle|surface|line|overlap-ends] [--output FILE] [--scene FILE]
 //
 // --scene FILE writes the first chain at the first d_hat as a scene file for stokescontact-run
 // (its poses, the pushes as per-body forces, one step; docs/scenes.md) and runs nothing else:
@@ -45,7 +45,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat LIST] [--solver NAME]\n"
     "                       [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
-    "                       [--directions particle|surface|line] [--output FILE] [--scene FILE]\n";
+    "                       [--directions particle|surface|line|overlap-ends] [--output FILE] [--scene FILE]\n";
 
 constexpr double kLRod = 0.5, kRRod = kLRod / 20.0, kDt = 0.05;  // Sec. 3.2.2
 

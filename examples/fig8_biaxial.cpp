@@ -6,7 +6,7 @@
 //   fig8_biaxial [--d-hat 0.01,0.1] [--dt 0.02,0.01,0.005] [--t-end 9] [--t-s 4.36]
 //                [--rows 5] [--columns 6] [--spacing-y 1.5] [--spacing-z 3]
 //                [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
-//                [--directions particle|surface|line] [--node-spacing 0] [--line-width 1]
+//                [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]
 //                [--line-angle 0.05] [--cost formed|matrix-free] [--max-steps N] [--tilt 0]
 //                [--max-iterations N] [--output FILE]
 //
@@ -51,7 +51,7 @@ constexpr const char* kUsage =
     "usage: fig8_biaxial [--d-hat 0.01,0.1] [--dt 0.02,0.01,0.005] [--t-end 9] [--t-s 4.36] [--rows 5]\n"
     "                    [--columns 6] [--spacing-y 1.5] [--spacing-z 3] [--solver NAME]\n"
     "                    [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
-    "                    [--directions particle|surface|line] [--node-spacing 0] [--line-width 1]\n"
+    "                    [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]\n"
     "                    [--line-angle 0.05] [--cost formed|matrix-free] [--max-steps N] [--tilt 0]\n"
     "                    [--max-iterations N] [--output FILE]\n";
 

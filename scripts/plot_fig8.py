@@ -17,7 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 STYLE = {"particle": ("tab:blue", "d^P (particle)"), "surface": ("tab:orange", "d^S (surface)"),
-         "line": ("tab:green", "line contacts")}
+         "line": ("tab:green", "line contacts"), "overlap-ends": ("tab:red", "overlap ends")}
 DASH = {"default": "-", "lcp-newton": "--"}
 
 

@@ -253,14 +253,17 @@ inline ContactSpec read_contact(const JsonReader& r, const SceneShape& shape) {
   }
   if (const auto m = r.find("max_iterations")) c.max_iterations = static_cast<int>(m->integer(1, 1000000));
   if (const auto d = r.find("directions")) {
-    const std::string dir = d->choice({"automatic", "particle", "surface", "line"});
-    c.step.directions = dir == "particle"  ? ContactDirections::particle
-                        : dir == "surface" ? ContactDirections::surface
-                        : dir == "line"    ? ContactDirections::particle
-                                           : ContactDirections::automatic;
+    const std::string dir = d->choice({"automatic", "particle", "surface", "line", "overlap-ends"});
+    c.step.directions = dir == "particle"       ? ContactDirections::particle
+                        : dir == "surface"      ? ContactDirections::surface
+                        : dir == "line"         ? ContactDirections::particle
+                        : dir == "overlap-ends" ? ContactDirections::overlap_ends
+                                                : ContactDirections::automatic;
     c.line_contact = dir == "line";
     if (c.line_contact && !std::holds_alternative<Spherocylinder>(shape))
       d->fail("'line' spreads the force of near-parallel rods: spherocylinders only");
+    if (dir == "overlap-ends" && !std::holds_alternative<Spherocylinder>(shape))
+      d->fail("'overlap-ends' holds near-parallel rods at both ends of their overlap: spherocylinders only");
   }
   if (const auto cost = r.find("cost"))
     c.step.cost = cost->choice({"formed", "matrix-free"}) == "formed" ? MobilityCost::formed : MobilityCost::matrix_free;

@@ -49,14 +49,16 @@ inline RodMobility make_rod_mobility(RodMobilityModel model, const sc::Spherocyl
 // Contact directions: "particle" (d^P, Broms & Tornberg eq. 20-21: the closest points of the
 // centre segments), "surface" (d^S, eq. 22-23: surface-node pairs), "line" (d^P constrained,
 // the force of near-parallel pairs spread over their overlap: geometry/line_contact.hpp,
-// rods as LineContactRod).
-enum class RodDirections { particle, surface, line };
+// rods as LineContactRod), "overlap-ends" (d^P, near-parallel pairs held at both ends of
+// their overlap: geometry/overlap_ends.hpp).
+enum class RodDirections { particle, surface, line, overlap_ends };
 
 inline RodDirections parse_directions(const std::string& name) {
   if (name == "particle") return RodDirections::particle;
   if (name == "surface") return RodDirections::surface;
   if (name == "line") return RodDirections::line;
-  throw std::invalid_argument("unknown contact directions '" + name + "' (known: particle, surface, line)");
+  if (name == "overlap-ends") return RodDirections::overlap_ends;
+  throw std::invalid_argument("unknown contact directions '" + name + "' (known: particle, surface, line, overlap-ends)");
 }
 
 inline const char* directions_name(RodDirections d) {
@@ -64,12 +66,15 @@ inline const char* directions_name(RodDirections d) {
     case RodDirections::particle: return "particle";
     case RodDirections::surface: return "surface";
     case RodDirections::line: return "line";
+    case RodDirections::overlap_ends: return "overlap-ends";
   }
   return "?";
 }
 
 inline sc::ContactDirections contact_directions(RodDirections d) {
-  return d == RodDirections::surface ? sc::ContactDirections::surface : sc::ContactDirections::particle;
+  return d == RodDirections::surface        ? sc::ContactDirections::surface
+         : d == RodDirections::overlap_ends ? sc::ContactDirections::overlap_ends
+                                            : sc::ContactDirections::particle;
 }
 
 // The line-contact rod of `rod`: full spreading below `angle` rad, force density falling to 0

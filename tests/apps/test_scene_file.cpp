@@ -145,6 +145,8 @@ TEST(SceneFile, BadInputNamesTheKeyPath) {
   j = two_spheres();
   j["contact"]["directions"] = "line";
   expect_error(j, "contact.directions", "spherocylinders only");
+  j["contact"]["directions"] = "overlap-ends";
+  expect_error(j, "contact.directions", "spherocylinders only");
 }
 
 TEST(SceneFile, OneShapeTypePerSceneSaysSo) {

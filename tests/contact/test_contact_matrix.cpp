@@ -54,7 +54,7 @@ void expect_rate_matches_finite_difference(const A& a, const B& b, double lo, do
     const sc::ClosestPoints cp = sc::closest_points(a, pa, b, pb);
     if (cp.distance + a.radius + b.radius < 0.05) continue;
     const std::vector<Pose> poses = {pa, pb};
-    const std::vector<sc::ContactPair> pair = {{0, 1, Vec3::Zero(), cp, std::nullopt}};
+    const std::vector<sc::ContactPair> pair = {{0, 1, Vec3::Zero(), cp, std::nullopt, std::nullopt}};
     const double rate = (sc::contact_matrix(pair, poses).transpose() * u)(0);
     const double h = 1e-6;
     auto distance_at = [&](double t) {
@@ -210,7 +210,7 @@ TEST(ContactMatrix, PositiveMagnitudeSeparatesBodies) {
     const Pose pa{Vec3::Zero(), test_support::random_rotation(rng)};
     const Pose pb = pose_nearby(rng, pa, 1.0, 2.5);
     const std::vector<Pose> poses = {pa, pb};
-    const std::vector<sc::ContactPair> pair = {{0, 1, Vec3::Zero(), sc::closest_points(b, pa, b, pb), std::nullopt}};
+    const std::vector<sc::ContactPair> pair = {{0, 1, Vec3::Zero(), sc::closest_points(b, pa, b, pb), std::nullopt, std::nullopt}};
     if (pair[0].points.distance + 2 * b.radius < 0.05) continue;  // curves (nearly) meet
     const VecX u = sc::MatX(sc::contact_matrix(pair, poses)).col(0);
     const double h = 1e-4;

@@ -128,7 +128,7 @@ inline ContactColumn surface_contact_column(const SurfaceContact& contact, std::
     add_distance_gradient(c, p.normal, p.point_a - x_i, p.point_b - x_j, w);
   }
   if (weight_sum == 0.0)  // every node pair sits at d_try: fall back to the closest points
-    return particle_contact_column({contact.i, contact.j, contact.image_shift, contact.distances.particle, std::nullopt}, poses,
+    return particle_contact_column({contact.i, contact.j, contact.image_shift, contact.distances.particle, std::nullopt, std::nullopt}, poses,
                                    field + ".distances.particle");
   const double scale = 1.0 / std::max(c.force_j.norm(), weights.min_net_force_fraction * weight_sum);
   c.force_j *= scale;

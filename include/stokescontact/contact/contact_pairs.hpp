@@ -20,6 +20,7 @@
 #include "stokescontact/geometry/broad_phase.hpp"
 #include "stokescontact/geometry/closest_points.hpp"
 #include "stokescontact/geometry/line_contact.hpp"
+#include "stokescontact/geometry/overlap_ends.hpp"
 
 namespace stokescontact {
 
@@ -34,6 +35,9 @@ struct ContactPair {
   // a line contact of two LineContactRods (geometry/line_contact.hpp), its distance the gap
   // at those points. `points` keeps d^P, the distance the contact step constrains.
   std::optional<ClosestPoints> force_points;
+  // One end of the overlap of two near-parallel rods (split_overlap_ends): `points` are that
+  // segment end and its closest point on the other rod, the distance constrained their gap.
+  std::optional<SegmentEnd> segment_end;
 };
 
 inline Pose shifted(const Pose& pose, const Vec3& shift) { return {pose.x + shift, pose.q}; }
@@ -55,7 +59,7 @@ template <Shape S>
 ContactPair contact_pair(std::span<const S> shapes, std::span<const Pose> poses, Eigen::Index i, Eigen::Index j,
                          const std::optional<PeriodicBox>& box) {
   const auto si = static_cast<std::size_t>(i), sj = static_cast<std::size_t>(j);
-  ContactPair pair{i, j, minimum_image_shift(poses[si].x, poses[sj].x, box), {}, std::nullopt};
+  ContactPair pair{i, j, minimum_image_shift(poses[si].x, poses[sj].x, box), {}, std::nullopt, std::nullopt};
   const S& a = shape_of(shapes, si);
   const S& b = shape_of(shapes, sj);
   const Pose pose_b = shifted(poses[sj], pair.image_shift);
@@ -77,7 +81,74 @@ ContactPair contact_pair(std::span<const S> shapes, std::span<const Pose> poses,
   return pair;
 }
 
+// The contact of segment end e of pair (i, j) at poses: that end's closest points, its gap.
+inline ContactPair overlap_end_pair(const Spherocylinder& a, const Pose& pose_a, const Spherocylinder& b,
+                                    const Pose& pose_b, Eigen::Index i, Eigen::Index j, const Vec3& image_shift,
+                                    SegmentEnd e) {
+  const Segment sa = to_world(centre_curve(a).segments[0], pose_a);
+  const Segment sb = to_world(centre_curve(b).segments[0], pose_b);
+  const CurveContact c{end_to_segment(sa, sb, e), unit_tangent(sa, 0.0), unit_tangent(sb, 0.0)};
+  return {i, j, image_shift, finish(c, a.radius, b.radius, pose_a.x, pose_b.x), std::nullopt, e};
+}
+
 }  // namespace detail
+
+// Near-parallel rods as line contacts held at both ends of their overlap (geometry/
+// overlap_ends.hpp; ContactDirections::overlap_ends): each pair of Spherocylinders whose
+// centre lines meet at an angle below max_angle, overlapping by at least the smaller radius,
+// becomes one contact per overlap end, plus its closest points when those lie inside the
+// overlap below both ends by more than rounding (the rods cross there). Other pairs, and
+// pairs of other shapes, stay as they are. Order is kept: a pair's contacts replace it.
+template <Shape S>
+std::vector<ContactPair> split_overlap_ends(std::vector<ContactPair> pairs, std::span<const S> shapes,
+                                            std::span<const Pose> poses, double max_angle) {
+  if constexpr (!std::is_same_v<S, Spherocylinder>) {
+    return pairs;
+  } else {
+    std::vector<ContactPair> out;
+    out.reserve(pairs.size());
+    for (ContactPair& p : pairs) {
+      if (p.segment_end) {
+        out.push_back(std::move(p));
+        continue;
+      }
+      const S& a = shape_of(shapes, static_cast<std::size_t>(p.i));
+      const S& b = shape_of(shapes, static_cast<std::size_t>(p.j));
+      const Pose& pose_a = poses[static_cast<std::size_t>(p.i)];
+      const Pose pose_b = shifted(poses[static_cast<std::size_t>(p.j)], p.image_shift);
+      const auto ends = overlap_ends(to_world(centre_curve(a).segments[0], pose_a),
+                                     to_world(centre_curve(b).segments[0], pose_b), max_angle,
+                                     std::min(a.radius, b.radius));
+      if (!ends) {
+        out.push_back(std::move(p));
+        continue;
+      }
+      const ContactPair low = detail::overlap_end_pair(a, pose_a, b, pose_b, p.i, p.j, p.image_shift, (*ends)[0]);
+      const ContactPair high = detail::overlap_end_pair(a, pose_a, b, pose_b, p.i, p.j, p.image_shift, (*ends)[1]);
+      const double rounding = 1e-12 * (a.length + b.length + a.radius + b.radius);
+      if (p.points.distance < std::min(low.points.distance, high.points.distance) - rounding)
+        out.push_back(std::move(p));
+      out.push_back(low);
+      out.push_back(high);
+    }
+    return out;
+  }
+}
+
+// Pair p (as flagged, perhaps an overlap end) measured again at poses.
+template <Shape S>
+ContactPair remeasured(const ContactPair& p, std::span<const S> shapes, std::span<const Pose> poses,
+                       const std::optional<PeriodicBox>& box) {
+  if constexpr (std::is_same_v<S, Spherocylinder>) {
+    if (p.segment_end)
+      return detail::overlap_end_pair(shape_of(shapes, static_cast<std::size_t>(p.i)),
+                                      poses[static_cast<std::size_t>(p.i)],
+                                      shape_of(shapes, static_cast<std::size_t>(p.j)),
+                                      shifted(poses[static_cast<std::size_t>(p.j)], p.image_shift), p.i, p.j,
+                                      p.image_shift, *p.segment_end);
+  }
+  return detail::contact_pair(shapes, poses, p.i, p.j, box);
+}
 
 // All pairs with d^P <= d_try (d_try >= 0), sorted by (i, j). `cells`, when given, keeps
 // the broad phase's buffers between calls.

@@ -46,12 +46,14 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <span>
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -87,7 +89,9 @@ enum class MobilityCost { formed, matrix_free };
 
 // Where contact forces act: the closest points (eq. 21) or the surface-node pairs (eq. 23);
 // automatic: surface for non-convex shapes (boomerangs), particle for convex ones.
-enum class ContactDirections { automatic, particle, surface };
+// overlap_ends (Spherocylinder scenes): the closest points, and near-parallel rods held at
+// both ends of their overlap, two constraints per pair (geometry/overlap_ends.hpp).
+enum class ContactDirections { automatic, particle, surface, overlap_ends };
 
 struct ContactStepOptions {
   MobilityCost cost = MobilityCost::formed;
@@ -102,6 +106,9 @@ struct ContactStepOptions {
   // Surface-node spacing h for eq. 23; 0: contact_node_spacing(shape, d_hat).
   double node_spacing = 0.0;
   SurfaceWeights surface_weights;
+  // overlap_ends: pairs of rods whose centre lines meet below this angle (radians) are held
+  // at both ends of their overlap.
+  double overlap_ends_angle = 0.1;
 
   void validate() const {
     if (!(separation_margin >= 0.0 && separation_margin < 1.0))
@@ -111,6 +118,9 @@ struct ContactStepOptions {
       fail_argument("ContactStepOptions.max_guarantee_rounds",
                     "must be >= 0, got " + std::to_string(max_guarantee_rounds));
     require_non_negative(node_spacing, "ContactStepOptions.node_spacing");
+    if (!(overlap_ends_angle > 0.0 && overlap_ends_angle <= 0.5 * std::numbers::pi))
+      fail_argument("ContactStepOptions.overlap_ends_angle",
+                    "must lie in (0, pi/2], got " + std::to_string(overlap_ends_angle));
   }
 
   // Whether a scene of shape S uses d^S for its contact directions.
@@ -185,7 +195,7 @@ inline ContactPair carried_pair(const CarriedContact& c, Eigen::Index i, Eigen::
                                 std::span<const Pose> poses) {
   const Vec3 ci = poses[static_cast<std::size_t>(i)].to_world(c.curve_point_i);
   const Vec3 cj = shifted(poses[static_cast<std::size_t>(j)], image_shift).to_world(c.curve_point_j);
-  ContactPair p{i, j, image_shift, {}, std::nullopt};
+  ContactPair p{i, j, image_shift, {}, std::nullopt, std::nullopt};
   p.points.distance = c.normal.dot(cj - ci) - c.radius_i - c.radius_j;
   p.points.normal = c.normal;
   p.points.curve_point_a = ci;
@@ -240,6 +250,8 @@ class ContactStep {
         fail_argument("d_try", "must be >= d_hat = " + std::to_string(problem.d_hat) + ", got " +
                                    std::to_string(d_try_));
     }
+    if (options.directions == ContactDirections::overlap_ends && !std::is_same_v<S, Spherocylinder>)
+      fail_argument("ContactStepOptions.directions", "overlap_ends holds pairs of rods: it needs a Spherocylinder scene");
     if (options.surface_directions<S>()) {
       for (const S& shape : problem.shapes)
         nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : contact_node_spacing(shape, problem.d_hat)));
@@ -263,24 +275,31 @@ class ContactStep {
     carried_.assign(pairs_.size(), std::nullopt);
     if (options.whole_step)
       for (std::size_t k = 0; k < pairs_.size(); ++k) carry_if_passing(k);
+    split_overlap_ends_from(0);
     rebuild();
     // Everything checked: only now touch the mobility.
     start_applications_ = mobility.applications();
     mobility.set_configuration(problem.poses);  // M at Q_t (eq. 13)
   }
 
-  // Adds pairs (i < j) not yet flagged, measured at Q*; returns how many were new.
+  // Adds pairs (i < j) not yet flagged, measured at Q*; returns how many were new. A pair
+  // held at its overlap ends only (overlap_ends) gains its closest points: it ended too
+  // close between them.
   std::size_t add_pairs(std::span<const ContactPair> found) {
-    std::set<std::pair<Eigen::Index, Eigen::Index>> known;
+    std::set<std::pair<Eigen::Index, Eigen::Index>> known, ends_only;
     for (std::size_t k = 0; k < pairs_.size(); ++k)
-      if (!carried_[k]) known.insert({pairs_[k].i, pairs_[k].j});
+      if (!carried_[k]) (pairs_[k].segment_end ? ends_only : known).insert({pairs_[k].i, pairs_[k].j});
     std::size_t added = 0;
+    const std::size_t first = pairs_.size();
+    std::vector<char> split;
     for (const ContactPair& p : found)
       if (known.insert({p.i, p.j}).second) {
         pairs_.push_back(detail::contact_pair(problem_.shapes, std::span<const Pose>(trial_), p.i, p.j, problem_.box));
         carried_.emplace_back();
+        split.push_back(!ends_only.contains({p.i, p.j}));
         ++added;
       }
+    split_overlap_ends_from(first, split);
     if (added > 0) rebuild();
     return added;
   }
@@ -347,8 +366,7 @@ class ContactStep {
       const ContactPair& p = pairs_[k];
       e.pairs.push_back(carried_[k]
                             ? carried_pair(*carried_[k], p.i, p.j, p.image_shift, std::span<const Pose>(e.poses))
-                            : detail::contact_pair(problem_.shapes, std::span<const Pose>(e.poses), p.i, p.j,
-                                                   problem_.box));
+                            : remeasured(p, problem_.shapes, std::span<const Pose>(e.poses), problem_.box));
       e.distances(static_cast<Eigen::Index>(k)) = e.pairs.back().points.distance;
     }
     return e;
@@ -408,6 +426,30 @@ class ContactStep {
     }
     D_ = assemble_contact_matrix(columns, trial_.size(), dofs_);
     columns_ = std::move(columns);
+  }
+
+  // With overlap_ends directions, the pairs from `first` on that are not carried become
+  // their overlap-end contacts (carried ones keep their one carried contact); `split_pair`,
+  // when given, says per pair from `first` whether it may be split.
+  void split_overlap_ends_from(std::size_t first, std::span<const char> split_pair = {}) {
+    if (options_.directions != ContactDirections::overlap_ends) return;
+    std::vector<ContactPair> split(pairs_.begin() + static_cast<std::ptrdiff_t>(first), pairs_.end());
+    std::vector<std::optional<CarriedContact>> carried(carried_.begin() + static_cast<std::ptrdiff_t>(first),
+                                                       carried_.end());
+    pairs_.resize(first);
+    carried_.resize(first);
+    for (std::size_t k = 0; k < split.size(); ++k) {
+      if (carried[k] || (!split_pair.empty() && !split_pair[k])) {
+        pairs_.push_back(split[k]);
+        carried_.push_back(carried[k]);
+        continue;
+      }
+      for (ContactPair& p : split_overlap_ends(std::vector<ContactPair>{split[k]}, problem_.shapes,
+                                               std::span<const Pose>(trial_), options_.overlap_ends_angle)) {
+        pairs_.push_back(std::move(p));
+        carried_.emplace_back();
+      }
+    }
   }
 
   // Flagged pair k passes through or sweeps past in the trial step when its distance along
