@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing, builds with warnings as errors and runs the
 # default test suite. `scripts/test.sh sanitize` does the same in the address+undefined
-# sanitizer build; `scripts/test.sh release -L long` passes extra arguments to ctest.
+# sanitizer build; `scripts/test.sh release -L geometry` passes extra arguments to ctest.
+# The full-size experiments (label long) run with `ctest --preset long` after a release build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-release}

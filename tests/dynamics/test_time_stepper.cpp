@@ -347,6 +347,52 @@ TEST(TimeStepper, BiaxialRodGridKeepsItsSymmetryAndContactCounts) {
   }
 }
 
+// The same 6-rod grid with every rod turned about x by up to 1e-6 rad (alternating signs),
+// the perturbation that rounding gives the 30-rod grid. Held at their closest points (d^P)
+// the tilted pairs get their force at an end of the overlap; held at both overlap ends
+// (ContactDirections::overlap_ends) each pair's tilt is what brings both ends to d_hat. Per
+// step: no pair below d_hat (1 - margin). Measured with the default solver: d^P fails
+// separation at the first contact step (step 40: pairs overlap inside the step); overlap ends
+// run all 50 steps (11 with contact) and the largest turn grows from 1e-6 to 2e-6 rad.
+TEST(TimeStepper, TiltedBiaxialRodGridWithOverlapEnds) {
+  using RodStepper = sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility>;
+  const sc::Spherocylinder rod{1.0, 0.5};
+  const double d_hat = 0.01 * rod.radius, tilt = 1e-6;
+  std::vector<sc::Pose> poses;
+  for (int row = 0; row < 2; ++row)
+    for (int col = 0; col < 3; ++col) {
+      const int k = 3 * row + col;
+      poses.push_back({sc::Vec3(0.0, 1.5 * (col - 1), 3.0 * (row - 0.5)),
+                       sc::Quat(Eigen::AngleAxisd((k % 2 == 0 ? 1.0 : -1.0) * tilt * (k + 1) / 6.0, sc::Vec3::UnitX()))});
+    }
+  for (const sc::ContactDirections directions : {sc::ContactDirections::particle, sc::ContactDirections::overlap_ends}) {
+    const bool ends = directions == sc::ContactDirections::overlap_ends;
+    SCOPED_TRACE(ends ? "overlap ends" : "d^P");
+    sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
+    sc::TimeStepperOptions o = options(0.02, d_hat);
+    o.background_flow = sc::LinearBackgroundFlow::biaxial_compression(1.0);
+    o.contact_step.directions = directions;
+    RodStepper stepper({rod}, poses, mobility, kDefault, o);
+    double max_turn = 0.0;
+    int steps = 0;
+    try {
+      for (int step = 1; step <= 50; ++step, ++steps) {
+        const sc::StepDiagnostics& d = stepper.step();
+        ASSERT_GE(d.min_distance_ratio, 1.0 - kMargin) << "step " << step;
+        for (const sc::Pose& p : stepper.poses()) max_turn = std::max(max_turn, p.q.angularDistance(sc::Quat::Identity()));
+      }
+    } catch (const std::runtime_error& e) {
+      std::printf("[tilted grid] %s: stopped after %d steps: %s\n", ends ? "overlap ends" : "d^P", steps, e.what());
+      if (ends) ADD_FAILURE() << e.what();
+    }
+    std::printf("[tilted grid] %s: %d steps, largest turn %.3g rad\n", ends ? "overlap ends" : "d^P", steps, max_turn);
+    if (ends) {
+      EXPECT_EQ(steps, 50);
+      EXPECT_LT(max_turn, 1e-5);
+    }
+  }
+}
+
 // A step whose contact solve fails separation throws and leaves Q_t. A at 0 rushes into B
 // at 2.5; B, pushed by the contact, hits C at 4.6, a pair the trial step does not flag
 // (B is at rest there, 0.1 > d_try away). Without guarantee rounds the solve must fail.
