@@ -99,8 +99,8 @@ namespace {
 const sc::Spherocylinder kRod{4.0, 0.5};
 constexpr double kForce = 100.0, kDt = 0.01, kDHat = 0.01;
 
-sc::Pose rod_along_x(double y, double turn = 0.0) {
-  return {sc::Vec3(0.0, y, 0.0), sc::Quat(Eigen::AngleAxisd(turn, sc::Vec3::UnitZ())) *
+sc::Pose rod_along_x(double y, double turn = 0.0, const sc::Vec3& frame = sc::Vec3::Zero()) {
+  return {frame + sc::Vec3(0.0, y, 0.0), sc::Quat(Eigen::AngleAxisd(turn, sc::Vec3::UnitZ())) *
                                      sc::Quat(Eigen::AngleAxisd(0.5 * std::numbers::pi, sc::Vec3::UnitY()))};
 }
 
@@ -112,8 +112,8 @@ struct Pair {
   sc::FreeDrainingMobility mobility{sc::spherocylinder_mobility(kRod, 1.0), 2, 6};
   sc::VecX U;
 
-  Pair(double gap, double turn) {
-    poses = {rod_along_x(0.0), rod_along_x(2.0 * kRod.radius + gap, turn)};
+  Pair(double gap, double turn, const sc::Vec3& frame = sc::Vec3::Zero()) {
+    poses = {rod_along_x(0.0, 0.0, frame), rod_along_x(2.0 * kRod.radius + gap, turn, frame)};
     sc::VecX F = sc::VecX::Zero(12);
     F(1) = kForce;
     F(7) = -kForce;
@@ -143,12 +143,13 @@ double relative_turn(const std::vector<sc::Pose>& poses) {
 
 // Exactly parallel: one contact at each end of the overlap, equal forces summing to the
 // exact force of the pair, lambda = f + (target - g0) / (2 dt mu_perp) (test_parallel_rods.cpp),
-// and no spin.
+// and no spin; also with the frame shifted by 1e4 along every axis.
 TEST(OverlapEnds, ParallelPairGetsEqualEndForcesAndNoSpin) {
   for (const auto& [name, solver] : {std::pair<const char*, sc::ContactSolver>{"default", sc::DefectCorrectionOptions{}},
-                                     {"lcp-newton", sc::LcpSequenceOptions{}}}) {
-    SCOPED_TRACE(name);
-    Pair s(kDHat, 0.0);
+                                     {"lcp-newton", sc::LcpSequenceOptions{}}})
+  for (const double shift : {0.0, 1e4}) {
+    SCOPED_TRACE(std::string(name) + " frame " + std::to_string(shift));
+    Pair s(kDHat, 0.0, sc::Vec3::Constant(shift));
     const sc::ContactStepResult r = sc::solve_contact_step(s.problem(), s.mobility, overlap_ends(), solver);
     ASSERT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
     ASSERT_EQ(r.lambda.size(), 2);
@@ -162,6 +163,28 @@ TEST(OverlapEnds, ParallelPairGetsEqualEndForcesAndNoSpin) {
     EXPECT_LT(max_spin(r), 1e-8);
     EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
   }
+}
+
+// The same pair across the side of a periodic box (cube of side 12): rod 1 at y = 11.29 meets
+// rod 0 at y = 0.3 through its image at y = -0.71, gap d_hat; pressed together across the side.
+TEST(OverlapEnds, ParallelPairAcrossAPeriodicSide) {
+  Pair s(kDHat, 0.0);
+  s.poses = {rod_along_x(0.3), rod_along_x(0.3 - 2.0 * kRod.radius - kDHat + 12.0)};
+  sc::VecX F = sc::VecX::Zero(12);
+  F(1) = -kForce;
+  F(7) = kForce;
+  s.mobility.set_configuration(s.poses);
+  s.U = s.mobility.apply(F);
+  const sc::ContactStepProblem<sc::Spherocylinder> problem{s.shapes, s.poses, s.U, kDt, kDHat, 0.0, 1.0,
+                                                           sc::PeriodicBox{sc::Vec3::Constant(12.0)}};
+  const sc::ContactStepResult r = sc::solve_contact_step(problem, s.mobility, overlap_ends(), sc::ContactSolver{});
+  ASSERT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+  ASSERT_EQ(r.lambda.size(), 2);
+  const double mu = sc::spherocylinder_mobility(kRod, 1.0)(0, 0);
+  const double exact = kForce + kDHat * sc::DefectCorrectionOptions{}.margin / (2.0 * kDt * mu);
+  EXPECT_NEAR(r.lambda.sum(), exact, 1e-4 * exact);
+  EXPECT_NEAR(r.lambda(0), r.lambda(1), 1e-4 * exact);
+  EXPECT_LT(max_spin(r), 1e-8);
 }
 
 // Tilted by 0.02 rad, one end at d_hat and the other 0.08 farther, pressed as above. Held at
