@@ -192,7 +192,7 @@ TEST(OverlapEnds, ParallelPairAcrossAPeriodicSide) {
 // linearisation about Q* allows (measured: 6.7e-5 rad, the far end's 1.3e-4 = 0.013 d_hat),
 // and every end ends at d_hat or above. (Held at its closest points only, d^P, the same step
 // turns it by 1.7 rad and fails separation.) The default solver: 3 applications. (The LCP
-// sequence stalls at min d / d_hat 0.996 here, after 20 or 200 LCPs, and says so.)
+// sequence stalls at min d / d_hat 0.995 here after 20 LCPs, 0.996 after 200, and says so.)
 TEST(OverlapEnds, TiltedPairTurnsTowardsParallelNotThrough) {
   const double tilt = 0.02;
   {
