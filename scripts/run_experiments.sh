@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
 # The contact-solver experiments of docs/results.md (Broms & Tornberg Fig. 4, Table 1, the
 # speed-versus-error comparison, contact over the whole step, the rod chains of Fig. 7, the
-# biaxial compression of Fig. 8 with Table 2, the random boomerangs of Fig. 9). Builds the
+# biaxial compression of Fig. 8 with Table 2, the random boomerangs of Fig. 9, the contact step
+# at scale and on dense networks). Builds the
 # drivers in Release, writes JSON lines to docs/data/ and the printed summaries to
 # docs/data/*.txt. About an hour on 2 cores.
-# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8|fig9|fig9-surface-blobs] ...
+# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8|fig9|fig9-surface-blobs|scale] ...
 #        (default: all but fig9-surface-blobs)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release -DSTOKESCONTACT_BUILD_TESTS=OFF -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build --preset release -j "$(nproc 2>/dev/null || echo 2)" --target fig4_spheres speed_vs_error \
-  continuous_detection fig7_rod_chains fig8_biaxial fig9_boomerangs
+  continuous_detection fig7_rod_chains fig8_biaxial fig9_boomerangs contact_step_scaling dense_contact_networks
 bin=build/release/examples
 data=docs/data
 mkdir -p "$data"
@@ -21,7 +22,7 @@ run() {  # name, command...
   "$@" --output "$data/$name.jsonl" | tee "$data/$name.txt"
 }
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(fig4 fig4-multiblob table1 speed whole-step fig7 fig8 fig9)
+[ ${#parts[@]} -eq 0 ] && parts=(fig4 fig4-multiblob table1 speed whole-step fig7 fig8 fig9 scale)
 for part in "${parts[@]}"; do
   case $part in
     fig4)
@@ -62,6 +63,17 @@ for part in "${parts[@]}"; do
         done
       done
       /usr/bin/python3 scripts/plot_fig8.py docs/figures/fig8_biaxial.png $data/fig8_free_draining_*.jsonl ;;
+    scale)  # 1e3-1e6 spheres, one process per cost mode (peak memory is per process); ~2 minutes
+      mkdir -p $data/scaling
+      $bin/contact_step_scaling --sizes 1000,3000,10000,30000,100000,300000,1000000 --cost matrix-free \
+        --output $data/scaling/matrix_free.jsonl | tee $data/scaling/contact_step_scaling.txt
+      $bin/contact_step_scaling --sizes 1000,3000,10000,30000 --cost formed --formed-max 30000 \
+        --output $data/scaling/formed.jsonl | tee -a $data/scaling/contact_step_scaling.txt
+      cat $data/scaling/matrix_free.jsonl $data/scaling/formed.jsonl > $data/scaling/contact_step_scaling.jsonl
+      rm $data/scaling/matrix_free.jsonl $data/scaling/formed.jsonl
+      /usr/bin/python3 scripts/plot_contact_step_scaling.py $data/scaling/contact_step_scaling.jsonl \
+        docs/figures/contact_step_scaling.png
+      run scaling/dense_contact_networks $bin/dense_contact_networks ;;
     *) echo "unknown part $part" >&2; exit 2 ;;
   esac
 done

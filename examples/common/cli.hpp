@@ -15,6 +15,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace examples {
@@ -184,7 +185,8 @@ inline double maximum(const std::vector<double>& v) {
 }
 
 // A driver's main: `parse` throwing std::invalid_argument prints the error and the usage
-// (exit 2), `run` throwing anything prints the error (exit 1).
+// (exit 2), `run` throwing anything prints the error (exit 1). A `run` that returns an int
+// gives the exit status itself (a run that found an ERROR); one that returns nothing exits 0.
 template <typename Parse, typename Run>
 int driver_main(const char* name, const char* usage, Parse&& parse, Run&& run) {
   try {
@@ -194,7 +196,8 @@ int driver_main(const char* name, const char* usage, Parse&& parse, Run&& run) {
     return 2;
   }
   try {
-    run();
+    if constexpr (std::is_same_v<decltype(run()), int>) return run();
+    else run();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: %s\n", name, e.what());
     return 1;

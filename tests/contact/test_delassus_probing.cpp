@@ -14,6 +14,8 @@
 #include "stokescontact/contact/solvers/lcp_sequence.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/rpy_mobility.hpp"
+#include "stokescontact/scenes/random.hpp"
+#include "stokescontact/scenes/sphere_packing.hpp"
 
 namespace sc = stokescontact;
 
@@ -61,8 +63,9 @@ void check_probing(M& mobility, double radius, int expected_probes, double toler
   probing.add(step, std::vector<Eigen::Index>{0, 1, 2, 3});
   EXPECT_EQ(probing.probes(), expected_probes);
   EXPECT_EQ(mobility.applications() - before, static_cast<std::size_t>(expected_probes));
-  EXPECT_EQ(probing.matrix(), probing.matrix().transpose());
-  const double error = (probing.matrix() - exact).cwiseAbs().maxCoeff() / exact.cwiseAbs().maxCoeff();
+  const sc::MatX probed(probing.matrix());
+  EXPECT_EQ(probed, probed.transpose());
+  const double error = (probed - exact).cwiseAbs().maxCoeff() / exact.cwiseAbs().maxCoeff();
   std::printf("[probing] radius %g: %d probes, max error %.3e of max |A|\n", radius, probing.probes(), error);
   EXPECT_LE(error, tolerance);
   // row(k) reads the probes as they are (before symmetrising): the same up to the error.
@@ -88,6 +91,51 @@ TEST(DelassusProbing, FreeDrainingSharedProbesAreExact) {
 TEST(DelassusProbing, RpySharedProbesLoseOnlyTheFarField) {
   sc::RpyMobility rpy(6, sc::RpyParameters{1.0, 1.0}, 3);
   check_probing(rpy, 8.0, 2, 1e-2);
+}
+
+// At scale the model is sparse and, with free-draining bodies, exact wherever it reads: 3000
+// spheres at packing 0.3 pushed at random; every entry between contacts closer than radius / 2
+// against the exact column (one application each), every other entry 0, and O(1) entries per
+// working-set contact.
+TEST(DelassusProbing, FreeDrainingModelAtScaleIsSparseAndExactWhereRead) {
+  const std::size_t n = 3000;
+  const sc::SpherePacking packing = sc::random_sequential_addition(n, 0.3, 11);
+  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  sc::Rng rng(11);
+  const std::vector<sc::Vec3> f = sc::random_forces(n, 100.0, rng);
+  sc::FreeDrainingMobility free(sc::sphere_mobility(shapes[0], 1.0), n, 3);
+  sc::VecX F(3 * static_cast<Eigen::Index>(n));
+  for (std::size_t k = 0; k < n; ++k) F.segment<3>(3 * static_cast<Eigen::Index>(k)) = f[k];
+  free.set_configuration(packing.poses);
+  const sc::VecX U = free.apply(F);
+  const sc::ContactStepProblem<sc::Sphere> problem{shapes, packing.poses, U, 0.01, 0.01};
+  sc::ContactStepOptions options;
+  options.cost = sc::MobilityCost::matrix_free;
+  sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility> step(problem, free, options);
+  std::vector<Eigen::Index> W;  // the pairs the trial step brings below d_hat
+  const sc::ContactEvaluation& trial = step.evaluate(sc::VecX::Zero(step.nc()));
+  for (Eigen::Index k = 0; k < step.nc(); ++k)
+    if (trial.distances(k) < problem.d_hat) W.push_back(k);
+  ASSERT_GE(W.size(), 100u);
+  const double radius = 4.0;
+  sc::DelassusProbing probing(step, radius);
+  probing.add(step, W);
+  EXPECT_LE(probing.probes(), 12);
+  const sc::MatX exact = exact_delassus(step, W);
+  const sc::MatX probed(probing.matrix());
+  const auto position = [&](Eigen::Index k) {
+    const sc::ContactPair& p = step.pairs()[static_cast<std::size_t>(k)];
+    return sc::Vec3(p.points.point_a + 0.5 * p.points.distance * p.points.normal);
+  };
+  const auto w = static_cast<Eigen::Index>(W.size());
+  for (Eigen::Index r = 0; r < w; ++r)
+    for (Eigen::Index c = 0; c < w; ++c) {
+      const bool read = 2.0 * (position(W[static_cast<std::size_t>(r)]) - position(W[static_cast<std::size_t>(c)])).norm() < radius;
+      EXPECT_NEAR(probed(r, c), read ? exact(r, c) : 0.0, 1e-12 * exact.cwiseAbs().maxCoeff()) << r << ", " << c;
+    }
+  EXPECT_LE(probing.matrix().nonZeros(), 8 * w);
+  std::printf("[probing at scale] %lld contacts of %lld flagged, %d probes, %lld nonzeros\n", static_cast<long long>(w),
+              static_cast<long long>(step.nc()), probing.probes(), static_cast<long long>(probing.matrix().nonZeros()));
 }
 
 TEST(DelassusProbing, RejectsANonPositiveRadius) {
@@ -126,15 +174,16 @@ TEST(SecantCorrection, HonoursEverySecantAndKeepsA0Elsewhere) {
       A0_W(r, c) = A0(rows[static_cast<std::size_t>(r)], rows[static_cast<std::size_t>(c)]);
       A_W(r, c) = A(rows[static_cast<std::size_t>(r)], rows[static_cast<std::size_t>(c)]);
     }
-  const sc::MatX corrected = secant.corrected(A0_W, rows);
-  EXPECT_LE((corrected * S - A_W * S).cwiseAbs().maxCoeff(), 1e-12);
+  const auto corrected = secant.corrected(A0_W, rows);
+  for (Eigen::Index l = 0; l < 3; ++l)
+    EXPECT_LE((corrected(S.col(l)) - A_W * S.col(l)).cwiseAbs().maxCoeff(), 1e-12);
   // A direction orthogonal to every step.
   const Eigen::HouseholderQR<sc::MatX> qr(S);
   const sc::VecX orthogonal = sc::MatX(qr.householderQ()).col(4);
   EXPECT_LE((S.transpose() * orthogonal).norm(), 1e-12);
-  EXPECT_LE((corrected * orthogonal - A0_W * orthogonal).norm(), 1e-12);
+  EXPECT_LE((corrected(orthogonal) - A0_W * orthogonal).norm(), 1e-12);
   secant.clear();
-  EXPECT_EQ(secant.corrected(A0_W, rows), A0_W);
+  EXPECT_EQ(secant.corrected(A0_W, rows)(orthogonal), A0_W * orthogonal);
 }
 
 }  // namespace
@@ -151,6 +200,43 @@ TEST(PositiveDefinite, KeepsADefiniteMatrixAndLiftsAnIndefiniteOne) {
   sc::MatX expected(2, 2);
   expected << 1.5 + 1.5e-3, 1.5 - 1.5e-3, 1.5 - 1.5e-3, 1.5 + 1.5e-3;  // eigenvalues 3 and 3e-3
   EXPECT_LE((lifted - expected).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+// The sparse lift: below the dense limit the same as the dense one; above it the first shift
+// A + tau I of the sequence floor x Gershgorin bound x 4^k that a Cholesky factorisation accepts.
+TEST(PositiveDefinite, SparseLiftShiftsBeyondTheDenseLimit) {
+  const auto tridiagonal = [](Eigen::Index n, double diagonal, double off) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      t.emplace_back(static_cast<int>(i), static_cast<int>(i), diagonal);
+      if (i + 1 < n) {
+        t.emplace_back(static_cast<int>(i), static_cast<int>(i + 1), off);
+        t.emplace_back(static_cast<int>(i + 1), static_cast<int>(i), off);
+      }
+    }
+    Eigen::SparseMatrix<double> A(n, n);
+    A.setFromTriplets(t.begin(), t.end());
+    return A;
+  };
+  // Definite (eigenvalues 2 + 2 cos(k pi / (n + 1)) > 0): unchanged at any size.
+  const Eigen::SparseMatrix<double> definite = tridiagonal(300, 2.0, -1.0);
+  EXPECT_EQ(sc::MatX(sc::detail::positive_definite(definite, 1e-3, 200)), sc::MatX(definite));
+  // Indefinite (eigenvalues 1 + 2 cos(k pi / (n + 1)), down to about -1).
+  const Eigen::SparseMatrix<double> small = tridiagonal(50, 1.0, 1.0);
+  EXPECT_LE((sc::MatX(sc::detail::positive_definite(small, 1e-3, 200)) -
+             sc::detail::positive_definite(sc::MatX(small), 1e-3))
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-14);
+  const Eigen::SparseMatrix<double> large = tridiagonal(300, 1.0, 1.0);
+  const sc::MatX lifted(sc::detail::positive_definite(large, 1e-3, 200));
+  const double tau = lifted(0, 0) - 1.0;
+  EXPECT_LE((lifted - sc::MatX(large) - tau * sc::MatX::Identity(300, 300)).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(Eigen::LLT<sc::MatX>(lifted).info(), Eigen::Success);
+  const double gershgorin = 3.0;  // largest absolute row sum
+  const double k = std::log(tau / (1e-3 * gershgorin)) / std::log(4.0);
+  EXPECT_NEAR(k, std::round(k), 1e-9);  // on the sequence
+  EXPECT_NE(Eigen::LLT<sc::MatX>(sc::MatX(large) + 0.25 * tau * sc::MatX::Identity(300, 300)).info(), Eigen::Success);
 }
 
 // A hard case: a simple-cubic lattice (5^3 spheres, gaps 0.01, phi ~ 0.52) squeezed towards

@@ -10,6 +10,7 @@
 // Steps are kept in the full contact space (Nc) and restricted to a working set when used,
 // since the working set may grow between steps.
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <Eigen/QR>
@@ -32,9 +33,29 @@ class SecantCorrection {
     changes_.clear();
   }
 
-  // A0 (on the working set `rows`, indices into the full space) corrected by every step.
-  MatX corrected(const MatX& A0, std::span<const Eigen::Index> rows) const {
-    if (steps_.empty()) return A0;
+  // A0 (on the working set `rows`, indices into the full space; dense or sparse) corrected by
+  // every step, as the operator x -> A0 x + (Y - A0 S) (S^+ x): O(nnz(A0) + n m) per product,
+  // never a dense n x n matrix. A0 must outlive it.
+  template <typename Matrix>
+  class Model {
+   public:
+    explicit Model(const Matrix& A0) : A0_(A0) {}
+    Model(const Matrix& A0, MatX left, const MatX& S) : A0_(A0), left_(std::move(left)), steps_(S) {}
+    VecX operator()(const VecX& x) const {
+      VecX out = A0_ * x;
+      if (left_.cols() > 0) out += left_ * VecX(steps_.solve(x));  // S^+ x: the minimum-norm least squares
+      return out;
+    }
+
+   private:
+    const Matrix& A0_;
+    MatX left_;                                       // Y - A0 S
+    Eigen::CompleteOrthogonalDecomposition<MatX> steps_;  // of S (n x m): S^+ x in O(n m)
+  };
+
+  template <typename Matrix>
+  Model<Matrix> corrected(const Matrix& A0, std::span<const Eigen::Index> rows) const {
+    if (steps_.empty()) return Model<Matrix>(A0);
     const auto n = static_cast<Eigen::Index>(rows.size());
     const auto m = static_cast<Eigen::Index>(steps_.size());
     MatX S(n, m), Y(n, m);
@@ -43,7 +64,8 @@ class SecantCorrection {
         S(r, l) = steps_[static_cast<std::size_t>(l)](rows[static_cast<std::size_t>(r)]);
         Y(r, l) = changes_[static_cast<std::size_t>(l)](rows[static_cast<std::size_t>(r)]);
       }
-    return A0 + (Y - A0 * S) * Eigen::CompleteOrthogonalDecomposition<MatX>(S).pseudoInverse();
+    MatX left = Y - A0 * S;
+    return Model<Matrix>(A0, std::move(left), S);
   }
 
  private:

@@ -1,0 +1,152 @@
+// The cost of one contact step as the suspension grows: N unit spheres placed by random
+// sequential addition at packing fraction phi (seed N), forces of random direction with
+// |f| = 100, free-draining mobility, dt = d_hat = 0.01 (the pushed pairs are those the trial
+// step brings below d_hat).
+//
+//   contact_step_scaling [--sizes 1000,10000,100000] [--phi 0.3] [--cost matrix-free,formed]
+//                        [--formed-max 10000] [--solver default] [--max-memory-mb 0]
+//                        [--output FILE]
+//
+// Per N and cost mode: the unconstrained step (M at Q_t, U = M f and Q* = Q_t + dt U), the
+// contact step (detection, solve and the whole-step guarantee), flagged and pushed pairs,
+// mobility applications, solver iterations, status, min d / d_hat after, sphere-steps per
+// second of the contact step and the process's peak resident memory so far (sizes run in the
+// order given). Formed mode runs only up to --formed-max bodies: it forms one column of M D per
+// working-set pair, O(N) each. --max-memory-mb > 0: ERROR when the peak exceeds it.
+// One JSON object per line (to --output if given, else stdout) and a readable summary.
+#include <stokescontact/stokescontact.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "common/cli.hpp"
+
+namespace sc = stokescontact;
+namespace ex = examples;
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: contact_step_scaling [--sizes 1000,10000,100000] [--phi 0.3] [--cost matrix-free,formed]\n"
+    "                            [--formed-max 10000] [--solver default] [--max-memory-mb 0] [--output FILE]\n";
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The process's peak resident set (VmHWM) in MiB; 0 where /proc does not say.
+double peak_memory_mb() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return 0.0;
+}
+
+sc::MobilityCost cost_from_name(const std::string& name) {
+  if (name == "matrix-free") return sc::MobilityCost::matrix_free;
+  if (name == "formed") return sc::MobilityCost::formed;
+  throw std::invalid_argument("--cost: unknown mode '" + name + "' (known: matrix-free, formed)");
+}
+
+struct Options {
+  std::vector<std::size_t> sizes;
+  double phi = 0.3;
+  std::vector<std::string> costs;
+  std::size_t formed_max = 10000;
+  std::string solver_name = "default";
+  double max_memory_mb = 0.0;
+  std::string output;
+};
+
+Options parse(int argc, char** argv) {
+  ex::Arguments args(argc, argv);
+  Options o;
+  for (const std::string& s : args.list("--sizes", {"1000", "10000", "100000"})) {
+    const long long v = std::stoll(s);
+    if (v < 2) throw std::invalid_argument("--sizes: each must be >= 2, got " + s);
+    o.sizes.push_back(static_cast<std::size_t>(v));
+  }
+  o.phi = args.number("--phi", 0.3, 0.0);
+  o.costs = args.list("--cost", {"matrix-free", "formed"});
+  for (const std::string& c : o.costs) cost_from_name(c);
+  o.formed_max = static_cast<std::size_t>(args.integer("--formed-max", 10000, 2));
+  o.solver_name = args.text("--solver", "default");
+  sc::contact_solver_from_name(o.solver_name);
+  o.max_memory_mb = args.number("--max-memory-mb", 0.0, 0.0);
+  o.output = args.text("--output", "");
+  args.reject_unknown();
+  return o;
+}
+
+// 0 when every step converged within the memory bound, 1 otherwise ("ERROR" lines say why).
+int run(const Options& o) {
+  const sc::ContactSolver solver = sc::contact_solver_from_name(o.solver_name);
+  ex::JsonLines sink(o.output);
+  const double dt = 0.01, d_hat = 0.01, force = 100.0;
+  std::printf("Contact step scaling: spheres at phi %g, |f| = %g, free draining, dt = d_hat = %g, solver %s\n"
+              "%9s %11s | %10s | %10s %6s | %7s %7s | %5s %4s | %9s | %10s | %8s | %s\n",
+              o.phi, force, dt, o.solver_name.c_str(), "N", "cost", "unconstr.", "contact", "ratio", "Nc", "pushed",
+              "apps", "its", "min d/dh", "sphere-st/s", "peak MB", "status");
+  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  bool ok = true;
+  for (const std::size_t n : o.sizes) {
+    const sc::SpherePacking packing = sc::random_sequential_addition(n, o.phi, n);
+    sc::Rng rng(n);
+    const std::vector<sc::Vec3> f = sc::random_forces(n, force, rng);
+    sc::VecX F(3 * static_cast<Eigen::Index>(n));
+    for (std::size_t k = 0; k < n; ++k) F.segment<3>(3 * static_cast<Eigen::Index>(k)) = f[k];
+    for (const std::string& cost_name : o.costs) {
+      const sc::MobilityCost cost = cost_from_name(cost_name);
+      if (cost == sc::MobilityCost::formed && n > o.formed_max) continue;
+      sc::FreeDrainingMobility mobility(sc::sphere_mobility(shapes[0], 1.0), n, 3);
+      auto start = std::chrono::steady_clock::now();
+      mobility.set_configuration(packing.poses);
+      const sc::VecX U = mobility.apply(F);
+      const std::vector<sc::Pose> trial = sc::advance_all(packing.poses, U, 3, dt);
+      const double unconstrained_s = seconds_since(start);
+      const sc::ContactStepProblem<sc::Sphere> problem{shapes, packing.poses, U, dt, d_hat};
+      sc::ContactStepOptions options;
+      options.cost = cost;
+      start = std::chrono::steady_clock::now();
+      const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, options, solver);
+      const double contact_s = seconds_since(start);
+      const auto pushed = static_cast<std::size_t>((r.lambda.array() > 0.0).count());
+      const double memory = peak_memory_mb();
+      const double rate = static_cast<double>(n) / contact_s;
+      sink.line("{\"N\": " + std::to_string(n) + ", \"phi\": " + sc::json_number(o.phi) + ", \"cost\": \"" +
+                cost_name + "\", \"solver\": \"" + o.solver_name + "\", \"unconstrained_s\": " +
+                sc::json_number(unconstrained_s) + ", \"contact_step_s\": " + sc::json_number(contact_s) +
+                ", \"flagged_pairs\": " + std::to_string(r.flagged_pairs) + ", \"pushed_pairs\": " +
+                std::to_string(pushed) + ", \"mobility_applications\": " + std::to_string(r.mobility_applications) +
+                ", \"iterations\": " + std::to_string(r.iterations) + ", \"guarantee_rounds\": " +
+                std::to_string(r.guarantee_rounds) + ", \"min_d_over_d_hat_after\": " +
+                sc::json_number(r.min_distance_ratio) + ", \"status\": \"" + std::string(sc::to_string(r.status)) +
+                "\", \"sphere_steps_per_s\": " + sc::json_number(rate) + ", \"peak_memory_mb\": " +
+                sc::json_number(memory) + "}");
+      std::printf("%9zu %11s | %9.4fs | %9.4fs %6.0f | %7zu %7zu | %5zu %4d | %9.6f | %10.3g | %8.0f | %s\n", n,
+                  cost_name.c_str(), unconstrained_s, contact_s, contact_s / unconstrained_s, r.flagged_pairs, pushed,
+                  r.mobility_applications, r.iterations, r.min_distance_ratio, rate, memory,
+                  std::string(sc::to_string(r.status)).c_str());
+      std::fflush(stdout);
+      if (r.status != sc::ContactStepStatus::converged) {
+        std::printf("ERROR: N = %zu, %s: %s\n", n, cost_name.c_str(), r.message.c_str());
+        ok = false;
+      }
+      if (o.max_memory_mb > 0.0 && memory > o.max_memory_mb) {
+        std::printf("ERROR: N = %zu: peak memory %.0f MB above --max-memory-mb %.0f\n", n, memory, o.max_memory_mb);
+        ok = false;
+      }
+    }
+  }
+  return ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  return ex::driver_main("contact_step_scaling", kUsage, [&] { o = parse(argc, argv); }, [&] { return run(o); });
+}
