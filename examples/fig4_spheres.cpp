@@ -5,7 +5,7 @@
 //
 //   fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500]
 //                [--solver NAME] [--mobility multiblob|rpy|free-draining]
-//                [--d-try-multiplier 1] [--d-try-rule absolute|relative] [--tol TOL]
+//                [--d-try-multiplier 1] [--d-try-rule absolute|relative] [--tol TOL] [--dt 0.01]
 //                [--cost formed|matrix-free]
 //                [--separation-margin 1e-3] [--end-of-step] [--pairs] [--output FILE] [--table1]
 //
@@ -43,7 +43,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500] [--solver NAME]\n"
-    "                    [--mobility multiblob|rpy|free-draining] [--d-try-multiplier 1]\n"
+    "                    [--mobility multiblob|rpy|free-draining] [--d-try-multiplier 1] [--dt 0.01]\n"
     "                    [--d-try-rule absolute|relative] [--tol TOL]\n"
     "                    [--cost formed|matrix-free] [--separation-margin 1e-3] [--end-of-step] [--pairs]\n"
     "                    [--output FILE]\n"
@@ -78,6 +78,8 @@ Options parse(int argc, char** argv) {
   // Fig. 4 uses the default solver; Table 1 is about the barrier method's TOL (eq. 29).
   o.solver = sc::contact_solver_from_name(args.text("--solver", o.table1 ? "barrier-slsqp" : "default"));
   o.mobility = ex::parse_mobility(args.text("--mobility", "multiblob"));
+  o.step.dt = args.number("--dt", ex::kTimeStep, 0.0);
+  sc::require_positive(o.step.dt, "--dt");
   o.step.d_try_multiplier = args.number("--d-try-multiplier", 1.0, 1.0);
   const std::string rule = args.text("--d-try-rule", "absolute");
   if (rule != "absolute" && rule != "relative")
@@ -108,7 +110,8 @@ std::string step_json(const Options& o, const ex::SphereScene& scene, double phi
   return "{\"record\": \"step\", \"seed\": " + std::to_string(scene.seed) + ", \"config\": " + std::to_string(config) +
          ", \"phi\": " + sc::json_number(phi) + ", \"phi_reached\": " + sc::json_number(scene.packing.phi) +
          ", \"spheres\": " + std::to_string(o.spheres) + ", \"mobility\": \"" + ex::mobility_name(o.mobility) +
-         "\", \"solver\": \"" + sc::contact_solver_name(o.solver) + "\", \"cost\": \"" + cost_name(o) + "\"" +
+         "\", \"solver\": \"" + sc::contact_solver_name(o.solver) + "\", \"cost\": \"" + cost_name(o) + "\", \"dt\": " +
+         sc::json_number(o.step.dt) +
          extra + ", " + ex::json_fields(r) + "}";
 }
 
@@ -125,6 +128,7 @@ std::string progress(const ex::StepRecord& r, double phi, int config) {
 struct PhiSummary {
   std::vector<double> min_after, applications, wall, nc;
   int respects = 0;  // configs with min d >= d_hat (1 - 1e-9)
+  int converged = 0;    // configs whose step reported `converged`
   int overlapping = 0;  // configs with a pair overlapping inside the step
   double deepest = 0.0;  // the smallest interior d / d_hat among them
 
@@ -134,6 +138,7 @@ struct PhiSummary {
     wall.push_back(r.wall_time_s);
     nc.push_back(static_cast<double>(r.flagged));
     respects += r.min_ratio_after >= ex::kRespectsDHat;
+    converged += r.status == "converged";
     if (r.interior_overlaps > 0) {
       ++overlapping;
       deepest = std::min(deepest, r.interior_min_ratio);
@@ -142,18 +147,20 @@ struct PhiSummary {
 };
 
 void print_fig4_summary(const Options& o, const std::vector<std::pair<double, PhiSummary>>& rows) {
-  std::printf("\nFig. 4: %zu spheres, %s mobility, solver %s, cost %s, d_try x %g (%s), TOL %s, %s\n", o.spheres,
-              ex::mobility_name(o.mobility), sc::contact_solver_name(o.solver).c_str(), cost_name(o),
+  std::printf("\nFig. 4: %zu spheres, %s mobility, solver %s, cost %s, dt %g, d_try x %g (%s), TOL %s, %s\n", o.spheres,
+              ex::mobility_name(o.mobility), sc::contact_solver_name(o.solver).c_str(), cost_name(o), o.step.dt,
               o.step.d_try_multiplier, o.step.d_try_rule == sc::DTryRule::relative ? "per pair" : "eq. 31",
               o.step.tol ? sc::json_number(*o.step.tol).c_str() : "the solver's own",
               o.step.options.whole_step ? "whole step" : "end of step only");
   std::printf("%5s %7s | %-29s | %9s | %-13s | %9s | %7s | %s\n", "phi", "configs", "min d/d_hat after (min med max)",
-              "d>=d_hat", "apps (med max)", "med wall", "med Nc", "overlap inside the step (configs, deepest d/d_hat)");
+              "d>=d_hat", "apps (med max)", "med wall", "med Nc",
+              "overlap inside the step (configs, deepest d/d_hat) | converged");
   for (const auto& [phi, s] : rows)
-    std::printf("%5.2f %7zu | %9.6f %9.6f %9.6f | %8.1f%% | %6.0f %6.0f | %8.3fs | %7.0f | %d, %.3g\n", phi,
+    std::printf("%5.2f %7zu | %9.6f %9.6f %9.6f | %8.1f%% | %6.0f %6.0f | %8.3fs | %7.0f | %d, %.3g | %d\n", phi,
                 s.min_after.size(), ex::minimum(s.min_after), ex::median(s.min_after), ex::maximum(s.min_after),
                 100.0 * s.respects / static_cast<double>(s.min_after.size()), ex::median(s.applications),
-                ex::maximum(s.applications), ex::median(s.wall), ex::median(s.nc), s.overlapping, s.deepest);
+                ex::maximum(s.applications), ex::median(s.wall), ex::median(s.nc), s.overlapping, s.deepest,
+                s.converged);
 }
 
 template <sc::MobilityOperator M>

@@ -126,6 +126,7 @@ sc::VecX unconstrained_velocities(M& mobility, const SphereScene& scene) {
 // One contact step and its numbers.
 
 struct StepSettings {
+  double dt = kTimeStep;          // the paper's 0.01; larger for the large-step runs
   double d_try_multiplier = 1.0;  // Sec. 3.1.2: 1, 1.1, 1.2
   // The paper's eq. 31 (one threshold from the fastest sphere), as its figures and tables
   // use; relative: the library's default, one threshold per pair from its relative motion.
@@ -186,7 +187,7 @@ template <sc::MobilityOperator M>
 StepRecord run_step(const sc::ContactSolver& solver, const SphereScene& scene, M& mobility, const sc::VecX& U,
                     const StepSettings& settings) {
   const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
-  const sc::ContactStepProblem<sc::Sphere> problem{shapes, scene.packing.poses, U, kTimeStep, scene.d_hat,
+  const sc::ContactStepProblem<sc::Sphere> problem{shapes, scene.packing.poses, U, settings.dt, scene.d_hat,
                                                    0.0,    settings.d_try_multiplier, {}, settings.d_try_rule};
   // TOL replaces the solver's own where it has one (default, barrier); the LCP sequence keeps
   // stopping at its first separated iterate.
@@ -202,18 +203,18 @@ StepRecord run_step(const sc::ContactSolver& solver, const SphereScene& scene, M
     if (r.lambda(k) > kActiveFraction * r.lambda_max) ++out.active;
     if (r.pairs[static_cast<std::size_t>(k)].points.distance < scene.d_hat) ++out.violating_trial;
   }
-  const std::vector<sc::Pose> trial = sc::advance_all(scene.packing.poses, U, dofs, kTimeStep);  // Q*, eq. 16
+  const std::vector<sc::Pose> trial = sc::advance_all(scene.packing.poses, U, dofs, settings.dt);  // Q*, eq. 16
   out.min_ratio_trial =
       sc::minimum_pair_distance(sc::Sphere{1.0}, std::span<const sc::Pose>(trial)).distance / scene.d_hat;
   out.min_ratio_after = r.min_distance_ratio;
   const sc::Sphere sphere{1.0};
   const auto inside = sc::trajectory_crossings(std::span<const sc::Sphere>(shapes), std::span<const sc::Pose>(scene.packing.poses),
-                                               r.velocities, dofs, kTimeStep, 0.0, 1e-12 * scene.d_hat);
+                                               r.velocities, dofs, settings.dt, 0.0, 1e-12 * scene.d_hat);
   out.interior_overlaps = inside.size();
   for (const sc::TrajectoryCrossing& c : inside) {
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const double lowest = sc::swept_minimum(sphere, scene.packing.poses[i], sc::rigid_velocity(r.velocities, i, dofs), sphere,
-                                            scene.packing.poses[j], sc::rigid_velocity(r.velocities, j, dofs), kTimeStep,
+                                            scene.packing.poses[j], sc::rigid_velocity(r.velocities, j, dofs), settings.dt,
                                             1e-12 * scene.d_hat)
                               .points.distance / scene.d_hat;
     out.interior_min_ratio = std::isnan(out.interior_min_ratio) ? lowest : std::min(out.interior_min_ratio, lowest);
