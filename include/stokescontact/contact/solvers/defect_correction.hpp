@@ -58,7 +58,7 @@
 // with products only (GMRES inside minimum-map Newton), the secant correction is a low-rank
 // operator (secant_update.hpp), and the lift to positive definite is a diagonal shift beyond
 // 200 pairs. Time and memory per correction are O(Nc + nnz A~) besides the application: one
-// step of 1e6 free-draining spheres with 9e4 pushed pairs runs in ~1.2 GB (docs/results.md).
+// step of 1e6 free-draining spheres with 9e4 pushed pairs ran in 1.1 GB (docs/results.md).
 // Iterations reported: corrections (LCPs solved).
 #include <algorithm>
 #include <limits>
