@@ -2,16 +2,17 @@
 # The contact-solver experiments of docs/results.md (Broms & Tornberg Fig. 4, Table 1, the
 # speed-versus-error comparison, contact over the whole step, the rod chains of Fig. 7, the
 # biaxial compression of Fig. 8 with Table 2, the random boomerangs of Fig. 9, the contact step
-# at scale and on dense networks). Builds the
+# at scale and on dense networks, the equation of state of Brownian hard spheres). Builds the
 # drivers in Release, writes JSON lines to docs/data/ and the printed summaries to
 # docs/data/*.txt. About an hour on 2 cores.
-# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8|fig9|fig9-surface-blobs|scale] ...
-#        (default: all but fig9-surface-blobs)
+# Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8|fig9|fig9-surface-blobs|scale|brownian] ...
+#        (default: all but fig9-surface-blobs and brownian; brownian alone takes about 75 minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release -DSTOKESCONTACT_BUILD_TESTS=OFF -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build --preset release -j "$(nproc 2>/dev/null || echo 2)" --target fig4_spheres speed_vs_error \
-  continuous_detection fig7_rod_chains fig8_biaxial fig9_boomerangs contact_step_scaling dense_contact_networks
+  continuous_detection fig7_rod_chains fig8_biaxial fig9_boomerangs contact_step_scaling dense_contact_networks \
+  brownian_hard_spheres
 bin=build/release/examples
 data=docs/data
 mkdir -p "$data"
@@ -74,6 +75,14 @@ for part in "${parts[@]}"; do
       /usr/bin/python3 scripts/plot_contact_step_scaling.py $data/scaling/contact_step_scaling.jsonl \
         docs/figures/contact_step_scaling.png
       run scaling/dense_contact_networks $bin/dense_contact_networks ;;
+    brownian)  # hard spheres: 5 packings x 3 step sizes (~65 min), then every solver at dt 1e-4 (~5 min)
+      mkdir -p $data/brownian
+      run brownian/hard_sphere_eos $bin/brownian_hard_spheres --phi 0.05,0.15,0.25,0.35,0.45 --n 400 \
+        --dt 4e-4,1e-4,2.5e-5 --equilibrate 1 --average 3 --seed 2
+      /usr/bin/python3 scripts/plot_hard_sphere_eos.py $data/brownian/hard_sphere_eos.jsonl \
+        docs/figures/hard_sphere_eos.png
+      run brownian/hard_sphere_solver_cost $bin/brownian_hard_spheres --phi 0.05,0.15,0.25,0.35,0.45 --n 400 \
+        --dt 1e-4 --equilibrate 0.2 --average 0.3 --seed 3 --solver default,lcp-bbpgd,lcp-apgd,lcp-newton ;;
     *) echo "unknown part $part" >&2; exit 2 ;;
   esac
 done

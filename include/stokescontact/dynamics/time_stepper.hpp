@@ -1,7 +1,12 @@
 #pragma once
 // Forward Euler with contact correction (Broms & Tornberg Sec. 2, 3.2.3). One step from Q_t:
-//   1. U = U_bg(Q_t) + M(Q_t) F_ext(t, Q_t)             (eq. 3, no Brownian term): one mobility
-//      application, skipped when F_ext = 0;
+//   1. U = U_bg(Q_t) + M(Q_t) F_ext(t, Q_t)             (eq. 3): one mobility application,
+//      skipped when F_ext = 0; with Brownian motion (options.brownian, kT > 0) also
+//      + sqrt(2 kT / dt) M^(1/2) W + kT div_q M       (Yan et al. eq. 29, U_known = U^B;
+//      Delong et al. 2015; docs/brownian.md), W ~ N(0, I) fresh each step from the stream of
+//      options.brownian->seed: mobility/brownian_velocity.hpp (exact square root or Lanczos)
+//      and mobility/thermal_drift.hpp (exact divergence or one RFD sample), their
+//      applications counted;
 //   2. a contact step from Q_t with U by the chosen solver (a ContactSolver value, the default
 //      solver unless told otherwise; or a custom callable): the trial step Q* = Q_t + dt Psi U
 //      (eq. 16), then lambda >= 0 and Q_{t+dt} = Q_t + dt Psi (U + M D lambda)  (eq. 13);
@@ -22,10 +27,18 @@
 // dt/2, each from its own start with its own U (steps 1-2), recursively up to
 // max_substep_halvings times (2^k sub-steps of dt/2^k). The step is committed only when every
 // sub-step succeeded; its diagnostics add up their work (substeps says how many).
+// A Brownian interval keeps its Gaussian W when halved (a Brownian bridge): with Z ~ N(0, I)
+// drawn afresh, the halves get W_1 = (W + Z) / sqrt 2 and W_2 = (W - Z) / sqrt 2, independent
+// N(0, I) whose displacements sqrt(2 kT dt/2) B (W_1 + W_2) add up to the failed attempt's
+// sqrt(2 kT dt) B W when B is constant. A failure therefore never redraws the noise, which
+// would bias the trajectory away from the configurations where steps fail (dense contacts).
 // Failures are not hidden: a step that still fails makes step() throw std::runtime_error with
 // the solver's message, and the state stays at Q_t. Bad input throws std::invalid_argument
 // naming the field before anything changes.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -41,8 +54,26 @@
 #include "stokescontact/contact/solvers/contact_solver.hpp"
 #include "stokescontact/dynamics/background_flow.hpp"
 #include "stokescontact/dynamics/step_diagnostics.hpp"
+#include "stokescontact/mobility/brownian_velocity.hpp"
+#include "stokescontact/mobility/thermal_drift.hpp"
 
 namespace stokescontact {
+
+// Thermal fluctuations of the bodies (see the top): temperature, the seed of the Gaussian
+// stream (core/gaussian_stream.hpp: the same seed gives the same trajectory), and the
+// fallbacks' settings for models without an exact square root or divergence.
+struct BrownianOptions {
+  double kT = 0.0;         // >= 0; 0: no fluctuations, nothing drawn
+  std::uint64_t seed = 0;
+  LanczosOptions lanczos;  // M^(1/2) W when the model has no apply_sqrt
+  RfdOptions rfd;          // kT div_q M when the model has no divergence()
+
+  void validate() const {
+    require_non_negative(kT, "brownian.kT");
+    lanczos.validate();
+    rfd.validate();
+  }
+};
 
 struct TimeStepperOptions {
   double dt = 0.0;                   // > 0
@@ -53,6 +84,7 @@ struct TimeStepperOptions {
   int max_substep_halvings = 4;      // in [0, 30]; 0: a failed step throws at once
   std::optional<PeriodicBox> box;    // none for open space
   std::optional<LinearBackgroundFlow> background_flow;  // none: fluid at rest
+  std::optional<BrownianOptions> brownian;               // none: no thermal fluctuations
   ContactStepOptions contact_step;   // given to the contact solver at every step
 
   void validate() const {
@@ -73,6 +105,7 @@ struct TimeStepperOptions {
         fail_argument("background_flow",
                       "is not allowed with a periodic box (u = E x is not periodic; no Lees-Edwards conditions)");
     }
+    if (brownian) brownian->validate();
     contact_step.validate();
   }
 };
@@ -108,7 +141,7 @@ class TimeStepper {
   TimeStepper(std::vector<S> shapes, std::vector<Pose> poses, M& mobility, ContactSolver contact_solver,
               TimeStepperOptions options, double t0 = 0.0)
       : shapes_(std::move(shapes)), poses_(std::move(poses)), mobility_(mobility), solver_(std::move(contact_solver)),
-        options_(std::move(options)), time_(t0), start_time_(t0) {
+        options_(std::move(options)), time_(t0), start_time_(t0), noise_(brownian_seed(options_)) {
     validate_and_wrap();
   }
 
@@ -116,7 +149,7 @@ class TimeStepper {
   TimeStepper(std::vector<S> shapes, std::vector<Pose> poses, M& mobility, CustomContactSolver contact_solver,
               TimeStepperOptions options, double t0 = 0.0)
       : shapes_(std::move(shapes)), poses_(std::move(poses)), mobility_(mobility), solver_(std::move(contact_solver)),
-        options_(std::move(options)), time_(t0), start_time_(t0) {
+        options_(std::move(options)), time_(t0), start_time_(t0), noise_(brownian_seed(options_)) {
     validate_and_wrap();
   }
 
@@ -162,7 +195,7 @@ class TimeStepper {
     d.min_distance_ratio = std::numeric_limits<double>::infinity();
     std::string failure;
     pending_.clear();
-    if (!advance_interval(poses, time_, options_.dt, 0, d, failure))
+    if (!advance_interval(poses, time_, options_.dt, 0, d, failure, draw_brownian_gaussian()))
       throw std::runtime_error("time step " + std::to_string(steps_ + 1) + " from t = " + std::to_string(time_) +
                                ": " + failure);
     // Commit Q_{t+dt}.
@@ -213,6 +246,15 @@ class TimeStepper {
     if (mobility_.size() != size())
       fail_argument("mobility", "has size " + std::to_string(mobility_.size()) + ", expected " +
                                     std::to_string(size()) + " (bodies * dofs_per_body)");
+    if (options_.box) {  // the broad phase's condition (geometry/broad_phase.hpp) with d_try = d_hat
+      double largest = 0.0;
+      for (const S& s : shapes_) largest = std::max(largest, bounding_radius(s));
+      const double needed = 2.0 * (2.0 * largest + options_.d_hat);
+      if (!(options_.box->lengths.minCoeff() >= needed))
+        fail_argument("box.lengths", "must be >= 2 (2 max bounding radius + d_hat) = " + std::to_string(needed) +
+                                         ", got a side of " + std::to_string(options_.box->lengths.minCoeff()) +
+                                         ": a body would meet its own image, or two images of another");
+    }
     const MinimumDistance closest =
         minimum_pair_distance(std::span<const S>(shapes_), std::span<const Pose>(poses_), options_.box);
     if (closest.distance < 0.0)
@@ -221,10 +263,20 @@ class TimeStepper {
     wrap_into_box();
   }
 
-  // Steps 1-2 over [t, t + h] from `poses`, advanced in place; on failed separation, two
-  // halves, down to max_substep_halvings. False (with the last message) if that fails too.
+  static std::uint64_t brownian_seed(const TimeStepperOptions& options) {
+    return options.brownian ? options.brownian->seed : 0;
+  }
+
+  bool brownian() const { return options_.brownian && options_.brownian->kT > 0.0; }
+
+  // The Gaussian W of a whole step (empty without Brownian motion).
+  VecX draw_brownian_gaussian() { return brownian() ? noise_.vector(size()) : VecX(); }
+
+  // Steps 1-2 over [t, t + h] from `poses`, advanced in place, with the interval's Gaussian W
+  // (Brownian motion only); on failed separation, two halves bridged from W (see the top),
+  // down to max_substep_halvings. False (with the last message) if that fails too.
   bool advance_interval(std::vector<Pose>& poses, double t, double h, int halvings, StepDiagnostics& d,
-                        std::string& failure) {
+                        std::string& failure, const VecX& W) {
     const std::span<const Pose> q_t(poses);
     // Eq. 3: U = U_bg + M F_ext.
     std::optional<VecX> forces;
@@ -242,6 +294,15 @@ class TimeStepper {
       U += mobility_.apply(*forces);
       applications = 1;
     }
+    if (brownian()) {  // + sqrt(2 kT / h) M^(1/2) W + kT div_q M
+      const BrownianOptions& b = *options_.brownian;
+      mobility_.set_configuration(q_t);
+      const MobilitySqrtProduct thermal = brownian_velocity(mobility_, b.kT, h, W, b.lanczos);
+      U += thermal.value;
+      applications += static_cast<std::size_t>(thermal.lanczos_iterations);
+      U += thermal_drift(mobility_, q_t, b.kT, noise_, b.rfd);
+      if constexpr (!ExactDivergenceMobility<M>) applications += 2;  // one centred RFD sample
+    }
     // Eq. 13/16 through the chosen solver.
     const ContactStepProblem<S> problem = make_problem(q_t, U, h);
     ContactStepResult result = solve(problem);
@@ -252,8 +313,14 @@ class TimeStepper {
       failure = result.message;
       if (halvings >= options_.max_substep_halvings) return false;
       // Halves: nothing was recorded for this attempt, and each half records its own.
-      return advance_interval(poses, t, 0.5 * h, halvings + 1, d, failure) &&
-             advance_interval(poses, t + 0.5 * h, 0.5 * h, halvings + 1, d, failure);
+      VecX W1, W2;
+      if (brownian()) {  // the bridge: W = (W1 + W2) / sqrt 2
+        const VecX Z = noise_.vector(size());
+        W1 = (W + Z) / std::sqrt(2.0);
+        W2 = (W - Z) / std::sqrt(2.0);
+      }
+      return advance_interval(poses, t, 0.5 * h, halvings + 1, d, failure, W1) &&
+             advance_interval(poses, t + 0.5 * h, 0.5 * h, halvings + 1, d, failure, W2);
     }
     if (result.poses.size() != poses.size())
       throw std::runtime_error("contact solver returned " + std::to_string(result.poses.size()) + " poses for " +
@@ -307,6 +374,7 @@ class TimeStepper {
   double start_time_ = 0.0;
   int dofs_ = 6;
   long steps_ = 0;
+  GaussianStream noise_;  // W of each step, bridges and RFD samples, in that order of use
   std::optional<VecX> forces_;
   ExternalForceField force_field_;
   std::vector<StepObserver> observers_;
