@@ -28,7 +28,6 @@
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
 #include <stokescontact/stokescontact.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -36,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "common/brownian_pressure.hpp"
 #include "common/cli.hpp"
 
 namespace sc = stokescontact;
@@ -125,17 +125,8 @@ bool within_tolerance(const Options& o, double phi, double dt, const std::string
   return false;
 }
 
-struct RunResult {
-  sc::BlockAverageResult z;
-  double eta = 0.0;
-  double pushed_per_step = 0.0, applications_per_step = 0.0, iterations_per_step = 0.0, substeps_per_step = 0.0;
-  double min_distance_ratio = 1e300;
-  double wall_s = 0.0;
-  long steps = 0;
-  std::string failure;
-};
-
-RunResult run_one(const Options& o, double phi, double dt, const std::string& solver_name) {
+// One (phi, dt, solver) run from the seed's packing; eta is the hard-sphere packing fraction.
+ex::BrownianPressureRun run_one(const Options& o, double phi, double dt, const std::string& solver_name) {
   constexpr double kT = 1.0, radius = 1.0;
   const double viscosity = 1.0 / (6.0 * std::numbers::pi);  // D0 = kT / (6 pi mu a) = 1
   sc::DensePackingOptions packing_options;
@@ -156,41 +147,8 @@ RunResult run_one(const Options& o, double phi, double dt, const std::string& so
   options.brownian->seed = o.seed;
   sc::TimeStepper<sc::Sphere, sc::FreeDrainingMobility> stepper(shapes, packing.poses, mobility,
                                                                  sc::contact_solver_from_name(solver_name), options);
-  const long equilibrate_steps = std::lround(o.equilibrate / dt);
-  const long average_steps = std::max(2L, std::lround(o.average / dt));
-  RunResult r;
-  const double sigma = 2.0 * radius + o.d_hat;
-  r.eta = phi * std::pow(sigma / (2.0 * radius), 3);
-  double step_pressure = 0.0;  // sum of (h / dt) tr(sigma^col) / 3 over the step's sub-steps
-  stepper.add_contact_observer([&](const sc::ContactStepProblem<sc::Sphere>& problem, const sc::ContactStepResult& result) {
-    if (result.lambda.size() > 0) step_pressure += problem.dt / dt * sc::contact_step_stress(problem, result).trace() / 3.0;
-  });
-  sc::BlockAverage z;
-  const auto start = std::chrono::steady_clock::now();
-  try {
-    for (long k = 0; k < equilibrate_steps + average_steps; ++k) {
-      step_pressure = 0.0;
-      const sc::StepDiagnostics d = stepper.step();
-      if (k < equilibrate_steps) continue;
-      z.add(1.0 + step_pressure / (static_cast<double>(o.n) * kT));
-      r.pushed_per_step += static_cast<double>(d.active_pairs);
-      r.applications_per_step += static_cast<double>(d.mobility_applications);
-      r.iterations_per_step += static_cast<double>(d.iterations);
-      r.substeps_per_step += static_cast<double>(d.substeps);
-      r.min_distance_ratio = std::min(r.min_distance_ratio, d.min_distance_ratio);
-      ++r.steps;
-    }
-  } catch (const std::runtime_error& e) {
-    r.failure = e.what();
-  }
-  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (r.steps >= 2) r.z = z.result();
-  const double steps = static_cast<double>(std::max(1L, r.steps));
-  r.pushed_per_step /= steps;
-  r.applications_per_step /= steps;
-  r.iterations_per_step /= steps;
-  r.substeps_per_step /= steps;
-  return r;
+  return ex::measure_brownian_pressure(stepper, kT, std::lround(o.equilibrate / dt),
+                                       std::max(2L, std::lround(o.average / dt)));
 }
 
 int run(const Options& o) {
@@ -205,14 +163,15 @@ int run(const Options& o) {
     for (const std::string& solver : o.solvers) {
       std::vector<ZAtStep> measured_z;
       for (const double dt : o.dts) {
-        const RunResult r = run_one(o, phi, dt, solver);
-        const double z_cs = carnahan_starling(r.eta);
-        const bool measured = r.steps >= 2;
+        const ex::BrownianPressureRun r = run_one(o, phi, dt, solver);
+        const double eta = phi * std::pow(1.0 + 0.5 * o.d_hat, 3);  // diameter 2a + d_hat, a = 1
+        const double z_cs = carnahan_starling(eta);
+        const bool measured = r.measured();
         const double z_mean = measured ? r.z.mean(0) : 0.0, z_error = measured ? r.z.std_error(0) : 0.0;
         const double deviation = z_mean / z_cs - 1.0;
         const bool error_converged = measured && r.z.all_converged();
         sink.line("{\"N\": " + std::to_string(o.n) + ", \"phi\": " + sc::json_number(phi) + ", \"eta\": " +
-                  sc::json_number(r.eta) + ", \"dt\": " + sc::json_number(dt) + ", \"d_hat\": " +
+                  sc::json_number(eta) + ", \"dt\": " + sc::json_number(dt) + ", \"d_hat\": " +
                   sc::json_number(o.d_hat) + ", \"solver\": \"" + solver + "\", \"seed\": " + std::to_string(o.seed) +
                   ", \"equilibrate\": " + sc::json_number(o.equilibrate) + ", \"average\": " +
                   sc::json_number(o.average) + ", \"steps_averaged\": " + std::to_string(r.steps) +
@@ -225,7 +184,7 @@ int run(const Options& o) {
                   ", \"min_d_over_d_hat\": " + sc::json_number(r.min_distance_ratio) + ", \"wall_s\": " +
                   sc::json_number(r.wall_s) + ", \"failure\": " + sc::json_quoted(r.failure) + "}");
         std::printf("%5.3f %8.5f %8.1e %-12s | %8.4f %8.4f %8.4f | %+7.2f %7.1f | %7.2f %6.2f %6.1f | %9.6f | %8.1f%s\n",
-                    phi, r.eta, dt, solver.c_str(), z_mean, z_error, z_cs, 100.0 * deviation,
+                    phi, eta, dt, solver.c_str(), z_mean, z_error, z_cs, 100.0 * deviation,
                     z_error > 0.0 ? (z_mean - z_cs) / z_error : 0.0, r.pushed_per_step, r.applications_per_step,
                     r.iterations_per_step, r.min_distance_ratio, r.wall_s, error_converged ? "" : "  (error bar not converged)");
         std::fflush(stdout);
@@ -238,7 +197,7 @@ int run(const Options& o) {
         measured_z.push_back({std::sqrt(dt), z_mean, z_error});
       }
       if (o.dts.size() < 2 || measured_z.size() != o.dts.size()) continue;
-      const double z_cs = carnahan_starling(phi * std::pow(1.0 + 0.5 * o.d_hat, 3));
+      const double z_cs = carnahan_starling(phi * std::pow(1.0 + 0.5 * o.d_hat, 3));  // as above
       const Extrapolated z0 = extrapolate_to_zero_step(measured_z);
       sink.line("{\"N\": " + std::to_string(o.n) + ", \"phi\": " + sc::json_number(phi) + ", \"dt\": 0, \"extrapolated\": true" +
                 ", \"solver\": \"" + solver + "\", \"Z\": " + sc::json_number(z0.z) + ", \"Z_error\": " +

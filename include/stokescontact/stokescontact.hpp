@@ -47,8 +47,9 @@
 #include "stokescontact/mobility/sphere_shell.hpp"
 #include "stokescontact/mobility/thermal_drift.hpp"
 
-// scenes: seeded random poses, forces and sphere packings
+// scenes: seeded random poses, forces, sphere packings and periodic placement of any shape
 #include "stokescontact/scenes/random.hpp"
+#include "stokescontact/scenes/periodic_placement.hpp"
 #include "stokescontact/scenes/sphere_packing.hpp"
 
 // lcp (needs only core)

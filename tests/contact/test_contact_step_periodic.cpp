@@ -214,4 +214,30 @@ TEST(ContactStepPeriodic, RandomSpheresInABoxEndSeparated) {
   }
 }
 
+// Contact forces that fling a body farther than the box allows (a solver's runaway lambda):
+// the step reports failed separation naming the body, instead of throwing from the whole-step
+// check's broad phase, so that a time stepper can sub-step it.
+TEST(ContactStepPeriodic, AForceThatFlingsABodyBeyondTheBoxIsAFailedStepNotAThrow) {
+  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  const std::vector<sc::Pose> poses = {{sc::Vec3(5.0, 5.0, 5.0), sc::Quat::Identity()},
+                                       {sc::Vec3(7.005, 5.0, 5.0), sc::Quat::Identity()}};
+  sc::VecX U = sc::VecX::Zero(6);
+  U(0) = 1.0;  // body 0 approaches body 1
+  const sc::ContactStepProblem<sc::Sphere> problem{shapes, poses, U, 0.01, 0.01, 0.0, 1.0,
+                                                   sc::PeriodicBox{sc::Vec3::Constant(kL)}};
+  sc::FreeDrainingMobility mobility(sc::sphere_mobility(shapes[0], 1.0), 2, 3);
+  const sc::ContactStepOptions options;  // whole-step guarantee on
+  // A solver core that returns a force moving the bodies apart by about 1e3 box sides.
+  const auto runaway = [](sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility>& step, const sc::VecX&) {
+    sc::ContactSolveOutcome out;
+    out.lambda = sc::VecX::Constant(step.nc(), 1e7);
+    out.converged = true;
+    return out;
+  };
+  sc::ContactStepResult r;
+  ASSERT_NO_THROW(r = sc::run_contact_step(problem, mobility, options, runaway));
+  EXPECT_EQ(r.status, sc::ContactStepStatus::failed_separation);
+  EXPECT_NE(r.message.find("moves too far in the step for the box"), std::string::npos) << r.message;
+}
+
 }  // namespace

@@ -1,6 +1,7 @@
 // TimeStepper with Brownian motion (TimeStepperOptions::brownian; Yan et al. eq. 29 with
 // U_known = U^B, docs/brownian.md): the increments' statistics, reproducibility, the Brownian
-// bridge of a halved step, hard spheres that stay apart, and bad input (a negative kT, a box too small for its bodies, an overlapping start).
+// bridge of a halved step, hard spheres that stay apart, and bad input (a negative kT, a box
+// too small for its bodies, an overlapping start).
 #include <gtest/gtest.h>
 
 #include <cmath>

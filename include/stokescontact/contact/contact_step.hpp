@@ -541,6 +541,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   ContactSolveOutcome outcome;
   std::vector<ContactPair> violating;
   std::vector<TrajectoryCrossing> crossing;
+  std::string beyond_box;  // why the corrected motion could not be checked in the box, if so
   // Overlaps deeper than separation_margin d_hat count, found within a tenth of that.
   const double overlap_tolerance = std::max(0.1 * options.separation_margin, 1e-6) * problem.d_hat;
   for (int round = 0;; ++round) {
@@ -555,9 +556,15 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
     std::erase_if(violating, [&](const ContactPair& p) { return step.separated(p.points.distance); });
     // The interior: no overlap along the corrected motion.
     const VecX V = problem.U + e.MD_lambda;
-    if (options.whole_step)
-      crossing = trajectory_crossings(problem.shapes, problem.poses, V, step.dofs_per_body(), problem.dt,
-                                      -options.separation_margin * problem.d_hat, overlap_tolerance, problem.box);
+    if (options.whole_step) {
+      try {
+        crossing = trajectory_crossings(problem.shapes, problem.poses, V, step.dofs_per_body(), problem.dt,
+                                        -options.separation_margin * problem.d_hat, overlap_tolerance, problem.box);
+      } catch (const MotionBeyondBox& e) {  // forces that fling a body: not a motion to check or keep
+        beyond_box = e.what();
+        break;
+      }
+    }
     if ((violating.empty() && crossing.empty()) || round == options.max_guarantee_rounds) break;
     // A pair too close at the end is held there by its end constraint; carried contacts are
     // for pairs that overlap inside the step only, or whose end constraint let them.
@@ -587,9 +594,10 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   r.lambda_sum = r.lambda.sum();
   r.lambda_max = r.lambda.size() == 0 ? 0.0 : r.lambda.maxCoeff();
   r.mobility_applications = step.applications();
-  if (!violating.empty() || !crossing.empty()) {
+  if (!violating.empty() || !crossing.empty() || !beyond_box.empty()) {
     std::ostringstream os;
     os << "failed separation after " << r.guarantee_rounds << " guarantee round(s):";
+    if (!beyond_box.empty()) os << " the corrected motion: " << beyond_box << ";";
     if (!violating.empty())
       os << " " << violating.size() << " pair(s) below d_hat (1 - " << options.separation_margin
          << ") at the end, min d / d_hat = " << r.min_distance_ratio << " (bodies " << violating.front().i << ", "

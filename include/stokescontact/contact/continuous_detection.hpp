@@ -26,6 +26,7 @@
 #include <cmath>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,15 @@ inline RigidVelocity rigid_velocity(const VecX& U, std::size_t body, int dofs_pe
 struct RelativePairs {
   std::vector<ContactPair> pairs;  // measured at Q*, sorted by (i, j)
   std::vector<double> d_try;       // one per pair
+};
+
+// A motion over the step that reaches farther than the periodic box allows: some pair of swept
+// balls spans more than half the shortest side, so the minimum image no longer names the one
+// image within reach. The motion is at fault, not the input (e.g. contact forces that fling a
+// body): a std::runtime_error, which the contact step reports as failed separation.
+class MotionBeyondBox : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 namespace detail {
@@ -82,6 +92,14 @@ struct SweptBodies {
 inline std::vector<BodyPair> swept_candidates(const Mat3X& centres, const VecX& radii, double body_radius,
                                               double cutoff, const std::optional<PeriodicBox>& box, CellList& list) {
   const auto n = centres.cols();
+  if (box && n > 0) {  // the broad phase's condition (2 max radius + cutoff <= half a side), as a motion's failure
+    Eigen::Index widest = 0;
+    const double r_max = radii.maxCoeff(&widest);
+    if (r_max + r_max + cutoff > 0.5 * box->lengths.minCoeff())
+      throw MotionBeyondBox("body " + std::to_string(widest) + " moves too far in the step for the box: its swept " +
+                            "ball of radius " + std::to_string(r_max) + " reaches beyond half the shortest side " +
+                            std::to_string(0.5 * box->lengths.minCoeff()));
+  }
   std::vector<Eigen::Index> slow, fast;
   for (Eigen::Index k = 0; k < n; ++k) (radii[k] > 2.0 * body_radius ? fast : slow).push_back(k);
   if (fast.empty() || fast.size() > 64) return list.find_pairs(centres, radii, cutoff, box);
@@ -94,12 +112,7 @@ inline std::vector<BodyPair> swept_candidates(const Mat3X& centres, const VecX& 
   std::vector<BodyPair> out;
   for (const BodyPair& p : list.find_pairs(slow_centres, slow_radii, cutoff, box))
     out.push_back({slow[static_cast<std::size_t>(p.i)], slow[static_cast<std::size_t>(p.j)]});
-  const double r_max = radii.maxCoeff();
   for (const Eigen::Index f : fast) {
-    if (box && radii[f] + r_max + cutoff > 0.5 * box->lengths.minCoeff())
-      fail_argument("PeriodicBox.lengths", "body " + std::to_string(f) + " moves too far in the step for the box: " +
-                                               "its reach " + std::to_string(radii[f] + r_max + cutoff) +
-                                               " exceeds half the shortest side");
     for (Eigen::Index k = 0; k < n; ++k) {
       if (k == f || (radii[k] > 2.0 * body_radius && k < f)) continue;  // fast pairs once
       if (is_candidate_pair(centres.col(f), centres.col(k), radii[f], radii[k], cutoff, box))

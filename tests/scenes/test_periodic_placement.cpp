@@ -1,0 +1,72 @@
+// periodic_random_placement: contact free through the minimum image (checked against every
+// image by brute force), inside the box, reproducible by seed, and clear errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "common/test_support.hpp"
+#include "stokescontact/geometry/closest_points.hpp"
+#include "stokescontact/scenes/periodic_placement.hpp"
+
+namespace sc = stokescontact;
+
+namespace {
+
+// The smallest gap between any two bodies over all 27 neighbouring images: no minimum image used.
+template <sc::Shape S>
+double smallest_gap_over_images(const S& shape, const std::vector<sc::Pose>& poses, double side) {
+  double best = 1e300;
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (std::size_t j = i + 1; j < poses.size(); ++j)
+      for (int a = -1; a <= 1; ++a)
+        for (int b = -1; b <= 1; ++b)
+          for (int c = -1; c <= 1; ++c) {
+            const sc::Pose image{poses[j].x + side * sc::Vec3(a, b, c), poses[j].q};
+            best = std::min(best, sc::closest_points(shape, poses[i], shape, image).distance);
+          }
+  return best;
+}
+
+TEST(PeriodicPlacement, RodsAreContactFreeAcrossTheBoundaryAndInsideTheBox) {
+  const sc::Spherocylinder rod{5.0, 0.5};
+  const double side = 16.0, gap = 0.05;
+  const std::vector<sc::Pose> poses = sc::periodic_random_placement(rod, 60, side, gap, 7);
+  ASSERT_EQ(poses.size(), 60u);
+  for (const sc::Pose& p : poses) {
+    EXPECT_TRUE((p.x.array() >= 0.0).all() && (p.x.array() < side).all());
+    EXPECT_NEAR(p.q.norm(), 1.0, 1e-14);
+  }
+  EXPECT_GT(smallest_gap_over_images(rod, poses, side), gap);
+  // The check above is not empty: some pairs come within 1 of each other across a face only.
+  const sc::PeriodicBox box{sc::Vec3::Constant(side)};
+  int across = 0;
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (std::size_t j = i + 1; j < poses.size(); ++j) {
+      const sc::Pose shifted{poses[j].x + sc::minimum_image_shift(poses[i].x, poses[j].x, box), poses[j].q};
+      across += shifted.x != poses[j].x && sc::closest_points(rod, poses[i], rod, shifted).distance < 1.0 ? 1 : 0;
+    }
+  EXPECT_GT(across, 0);
+  const std::vector<sc::Pose> again = sc::periodic_random_placement(rod, 60, side, gap, 7);
+  for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(poses[k].x, again[k].x);
+  const std::vector<sc::Pose> other = sc::periodic_random_placement(rod, 60, side, gap, 8);
+  EXPECT_NE(poses[0].x, other[0].x);
+}
+
+TEST(PeriodicPlacement, RejectsABoxTooSmallAndReportsAPackingItCannotFinish) {
+  const sc::Spherocylinder rod{5.0, 0.5};
+  test_support::expect_rejects([&] { sc::periodic_random_placement(rod, 2, 11.9, 0.0, 1); }, "side");
+  test_support::expect_rejects([&] { sc::periodic_random_placement(rod, 2, 20.0, -0.1, 1); }, "min_gap");
+  test_support::expect_rejects([&] { sc::periodic_random_placement(rod, 2, 20.0, 0.1, 1, 0); }, "max_attempts");
+  // Unit spheres (bounding diameter 2) at 200 in a box of 8: phi 1.6, impossible.
+  try {
+    sc::periodic_random_placement(sc::Sphere{1.0}, 200, 8.0, 0.0, 1, 1000);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("1000 draws in a row were rejected"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
