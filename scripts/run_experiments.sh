@@ -6,7 +6,7 @@
 # drivers in Release, writes JSON lines to docs/data/ and the printed summaries to
 # docs/data/*.txt. About an hour on 2 cores.
 # Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8|fig9|fig9-surface-blobs|scale|brownian] ...
-#        (default: all but fig9-surface-blobs and brownian; brownian alone takes about 75 minutes)
+#        (default: all but fig9-surface-blobs and brownian; brownian alone takes about 50 minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release -DSTOKESCONTACT_BUILD_TESTS=OFF -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF >/dev/null
@@ -75,7 +75,7 @@ for part in "${parts[@]}"; do
       /usr/bin/python3 scripts/plot_contact_step_scaling.py $data/scaling/contact_step_scaling.jsonl \
         docs/figures/contact_step_scaling.png
       run scaling/dense_contact_networks $bin/dense_contact_networks ;;
-    brownian)  # hard spheres: 5 packings x 3 step sizes (~65 min), then every solver at dt 1e-4 (~5 min)
+    brownian)  # hard spheres: 5 packings x 3 step sizes (~45 min), then every solver at dt 1e-4 (~5 min)
       mkdir -p $data/brownian
       run brownian/hard_sphere_eos $bin/brownian_hard_spheres --phi 0.05,0.15,0.25,0.35,0.45 --n 400 \
         --dt 4e-4,1e-4,2.5e-5 --equilibrate 1 --average 3 --seed 2
