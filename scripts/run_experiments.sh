@@ -6,7 +6,7 @@
 # drivers in Release, writes JSON lines to docs/data/ and the printed summaries to
 # docs/data/*.txt. About an hour on 2 cores.
 # Usage: scripts/run_experiments.sh [fig4|fig4-multiblob|table1|speed|whole-step|fig7|fig8|fig9|fig9-surface-blobs|scale|brownian] ...
-#        (default: all but fig9-surface-blobs and brownian; brownian alone takes about 50 minutes)
+#        (default: all but fig9-surface-blobs and brownian; brownian alone takes about 60 minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset release -DSTOKESCONTACT_BUILD_TESTS=OFF -DSTOKESCONTACT_BUILD_BENCHMARKS=OFF >/dev/null
@@ -82,7 +82,12 @@ for part in "${parts[@]}"; do
       /usr/bin/python3 scripts/plot_hard_sphere_eos.py $data/brownian/hard_sphere_eos.jsonl \
         docs/figures/hard_sphere_eos.png
       run brownian/hard_sphere_solver_cost $bin/brownian_hard_spheres --phi 0.05,0.15,0.25,0.35,0.45 --n 400 \
-        --dt 1e-4 --equilibrate 0.2 --average 0.3 --seed 3 --solver default,lcp-bbpgd,lcp-apgd,lcp-newton ;;
+        --dt 1e-4 --equilibrate 0.2 --average 0.3 --seed 3 --solver default,lcp-bbpgd,lcp-apgd,lcp-newton
+      # rods, passive and self-propelled (~7 min, Yan Fig. 6)
+      run brownian/rods_phi002_dt1e-3 $bin/brownian_rods --n 1000 --phi 0.02 --u0 0,1,2,4 --dt 1e-3 \
+        --equilibrate 0.2 --average 2 --seed 1
+      run brownian/rods_phi002_dt2.5e-4 $bin/brownian_rods --n 1000 --phi 0.02 --u0 0 --dt 2.5e-4 \
+        --equilibrate 0.2 --average 1 --seed 1 ;;
     *) echo "unknown part $part" >&2; exit 2 ;;
   esac
 done

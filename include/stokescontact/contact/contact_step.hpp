@@ -35,7 +35,15 @@
 //   interior: along the corrected motion Q_t + t' Psi (U + M D lambda), t' in [0, dt], no
 //             pair overlaps: d(t') >= -separation_margin d_hat (conservative advancement,
 //             exact for spheres). A pair that does is added as a carried contact, from where
-//             it first comes within d_hat on the corrected motion.
+//             it first comes within d_hat on the corrected motion. A carried pair that still
+//             overlaps (its end gap holds, but a turning body's arc passes through the other
+//             on the way) gets an interior contact: its closest points where it comes closest
+//             on the corrected motion, t_c, carried, with that normal, and the constraint on
+//             their gap at t_c itself, d(Q_t + t_c Psi (U + M D lambda)) >= d_hat / 2, whose
+//             column is t_c / dt times the gap's gradient there (only t_c of the correction
+//             acts before t_c; the space-time constraint of Lu, Rahimian & Zorin 2017 at one
+//             time). Its distance is reported as that gap plus d_hat / 2, so every solver
+//             holds it at d_hat like any other pair.
 // The interior bound is no overlap, not d_hat: d_hat is the margin the next step's
 // linearisation needs at its start, while inside a step only overlap is unphysical; a
 // rotating body held at d_hat at the end may come closer inside without touching. The step
@@ -46,6 +54,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <optional>
 #include <set>
@@ -180,6 +189,9 @@ struct ContactSolveOutcome {
 // A pair constrained where it first came within d_hat (see the top of this file): its
 // centre-curve points in each body's frame (body j: its image), carried with the bodies,
 // and the normal of that moment, fixed.
+// An interior contact (interior = true) is held at its own time t_c inside the step instead
+// of at the end: the pair's gap at Q_t + t_c Psi (U + M D lambda), where it came closest on a
+// corrected motion that still overlapped there (see the top of this file).
 struct CarriedContact {
   Vec3 curve_point_i = Vec3::Zero();
   Vec3 curve_point_j = Vec3::Zero();
@@ -187,14 +199,15 @@ struct CarriedContact {
   double radius_i = 0.0;
   double radius_j = 0.0;
   double time = 0.0;  // t_c in [0, dt]
+  bool interior = false;
 };
 
-// The carried contact of bodies i, j (image shift) at a configuration: points, fixed normal
-// and their gap along it, d = n . (c_j - c_i) - r_i - r_j.
+// The carried contact of bodies i, j at their poses (pose_j of j's image): points, fixed
+// normal and their gap along it, d = n . (c_j - c_i) - r_i - r_j.
 inline ContactPair carried_pair(const CarriedContact& c, Eigen::Index i, Eigen::Index j, const Vec3& image_shift,
-                                std::span<const Pose> poses) {
-  const Vec3 ci = poses[static_cast<std::size_t>(i)].to_world(c.curve_point_i);
-  const Vec3 cj = shifted(poses[static_cast<std::size_t>(j)], image_shift).to_world(c.curve_point_j);
+                                const Pose& pose_i, const Pose& pose_j) {
+  const Vec3 ci = pose_i.to_world(c.curve_point_i);
+  const Vec3 cj = pose_j.to_world(c.curve_point_j);
   ContactPair p{i, j, image_shift, {}, std::nullopt, std::nullopt};
   p.points.distance = c.normal.dot(cj - ci) - c.radius_i - c.radius_j;
   p.points.normal = c.normal;
@@ -204,6 +217,13 @@ inline ContactPair carried_pair(const CarriedContact& c, Eigen::Index i, Eigen::
   // points lie along the normal and this is the gap's exact gradient).
   p.points.point_a = p.points.point_b = 0.5 * (ci + cj);
   return p;
+}
+
+// The same at a configuration of all bodies.
+inline ContactPair carried_pair(const CarriedContact& c, Eigen::Index i, Eigen::Index j, const Vec3& image_shift,
+                                std::span<const Pose> poses) {
+  return carried_pair(c, i, j, image_shift, poses[static_cast<std::size_t>(i)],
+                      shifted(poses[static_cast<std::size_t>(j)], image_shift));
 }
 
 // Q(lambda) with its flagged-pair distances and closest points.
@@ -304,20 +324,38 @@ class ContactStep {
     return added;
   }
 
-  // Adds carried contacts for pairs that overlap inside the step on the motion with
-  // velocities V, from where each first comes within d_hat on it; a pair that already has
-  // one is not added again. Returns how many were new.
+  // Adds contacts for pairs that overlap inside the step on the motion with velocities V: a
+  // carried contact from where the pair first comes within d_hat on it; for a pair that
+  // already has one (its end gap holds, yet it overlaps on the way: a rotation's arc), an
+  // interior contact at the time it comes closest, unless it has one within dt / 1000 of
+  // that time. Returns how many were new.
   std::size_t add_crossings(std::span<const TrajectoryCrossing> found, const VecX& V) {
-    std::set<std::pair<Eigen::Index, Eigen::Index>> known;
-    for (std::size_t k = 0; k < pairs_.size(); ++k)
-      if (carried_[k]) known.insert({pairs_[k].i, pairs_[k].j});
+    std::set<std::pair<Eigen::Index, Eigen::Index>> carried;
+    std::multimap<std::pair<Eigen::Index, Eigen::Index>, double> interior_times;
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+      if (!carried_[k]) continue;
+      const std::pair<Eigen::Index, Eigen::Index> key{pairs_[k].i, pairs_[k].j};
+      if (carried_[k]->interior)
+        interior_times.insert({key, carried_[k]->time});
+      else
+        carried.insert(key);
+    }
     std::size_t added = 0;
-    for (const TrajectoryCrossing& c : found)
-      if (known.insert({c.i, c.j}).second) {
-        carried_.push_back(first_approach(c.i, c.j, c.image_shift, V));
-        pairs_.push_back(carried_pair(*carried_.back(), c.i, c.j, c.image_shift, std::span<const Pose>(trial_)));
-        ++added;
+    for (const TrajectoryCrossing& c : found) {
+      if (carried.insert({c.i, c.j}).second) {
+        carried_.push_back(carried_contact(c.i, c.j, c.image_shift, V, false));
+      } else {
+        CarriedContact closest = carried_contact(c.i, c.j, c.image_shift, V, true);
+        const auto [first, last] = interior_times.equal_range({c.i, c.j});
+        if (std::any_of(first, last, [&](const auto& t) { return std::abs(t.second - closest.time) < 1e-3 * problem_.dt; }))
+          continue;
+        interior_times.insert({{c.i, c.j}, closest.time});
+        carried_.push_back(closest);
       }
+      pairs_.push_back(carried_at(*carried_.back(), {c.i, c.j, c.image_shift, {}, std::nullopt, std::nullopt},
+                                  problem_.U, std::span<const Pose>(trial_)));
+      ++added;
+    }
     if (added > 0) rebuild();
     return added;
   }
@@ -359,14 +397,14 @@ class ContactStep {
   ContactEvaluation measure(VecX MD_lambda) const {
     ContactEvaluation e;
     e.MD_lambda = std::move(MD_lambda);
-    e.poses = advance_all(problem_.poses, problem_.U + e.MD_lambda, dofs_, problem_.dt);  // eq. 13
+    const VecX V = problem_.U + e.MD_lambda;
+    e.poses = advance_all(problem_.poses, V, dofs_, problem_.dt);  // eq. 13
     e.pairs.reserve(pairs_.size());
     e.distances.resize(nc());
     for (std::size_t k = 0; k < pairs_.size(); ++k) {
       const ContactPair& p = pairs_[k];
-      e.pairs.push_back(carried_[k]
-                            ? carried_pair(*carried_[k], p.i, p.j, p.image_shift, std::span<const Pose>(e.poses))
-                            : remeasured(p, problem_.shapes, std::span<const Pose>(e.poses), problem_.box));
+      e.pairs.push_back(carried_[k] ? carried_at(*carried_[k], p, V, std::span<const Pose>(e.poses))
+                                    : remeasured(p, problem_.shapes, std::span<const Pose>(e.poses), problem_.box));
       e.distances(static_cast<Eigen::Index>(k)) = e.pairs.back().points.distance;
     }
     return e;
@@ -375,7 +413,15 @@ class ContactStep {
   // The contact matrix of the flagged pairs at an evaluated configuration: D_k, with
   // D_k^T U = the rate of change of their distances there.
   Eigen::SparseMatrix<double> contact_matrix_at(const ContactEvaluation& e) const {
-    return contact_matrix(std::span<const ContactPair>(e.pairs), std::span<const Pose>(e.poses), dofs_);
+    const VecX V = problem_.U + e.MD_lambda;
+    std::vector<ContactColumn> columns;
+    columns.reserve(pairs_.size());
+    for (std::size_t k = 0; k < pairs_.size(); ++k)
+      columns.push_back(carried_[k] && carried_[k]->interior
+                            ? interior_column(*carried_[k], e.pairs[k], V)
+                            : detail::particle_contact_column(e.pairs[k], std::span<const Pose>(e.poses),
+                                                              "pairs[" + std::to_string(k) + "]"));
+    return assemble_contact_matrix(columns, e.poses.size(), dofs_);
   }
 
   // The barrier of eq. 15: b of eq. 10 with eps_reg = d_try (Remark 4; the value is Sec. 2.3's).
@@ -412,6 +458,10 @@ class ContactStep {
     for (std::size_t k = 0; k < pairs_.size(); ++k) {
       const ContactPair& p = pairs_[k];
       const std::string field = "pairs[" + std::to_string(k) + "]";
+      if (carried_[k] && carried_[k]->interior) {
+        columns.push_back(interior_column(*carried_[k], p, problem_.U));
+        continue;
+      }
       if (!weight_barrier || carried_[k]) {
         columns.push_back(detail::particle_contact_column(p, trial, field));
         continue;
@@ -464,25 +514,66 @@ class ContactStep {
         swept_minimum(shape_of(problem_.shapes, i), problem_.poses[i], vi, shape_of(problem_.shapes, j),
                       shifted(problem_.poses[j], p.image_shift), vj, problem_.dt, 0.5 * margin);
     if (!(lowest.points.distance < std::min(p.points.distance, problem_.d_hat) - margin)) return;
-    carried_[k] = first_approach(p.i, p.j, p.image_shift, problem_.U);
+    carried_[k] = carried_contact(p.i, p.j, p.image_shift, problem_.U, false);
     pairs_[k] = carried_pair(*carried_[k], p.i, p.j, p.image_shift, std::span<const Pose>(trial_));
   }
 
-  // The carried contact of a pair from where it first comes within d_hat on the motion with
-  // velocities V (at t = 0 if it starts there).
-  CarriedContact first_approach(Eigen::Index i, Eigen::Index j, const Vec3& image_shift, const VecX& V) const {
+  // The carried contact of a pair on the motion with velocities V: its closest points where
+  // it first comes within d_hat (at t = 0 if it starts there) or, for an interior contact,
+  // where it comes closest, carried with the bodies, with the normal of that moment.
+  CarriedContact carried_contact(Eigen::Index i, Eigen::Index j, const Vec3& image_shift, const VecX& V,
+                                 bool interior) const {
     const auto si = static_cast<std::size_t>(i), sj = static_cast<std::size_t>(j);
     const S& shape_i = shape_of(problem_.shapes, si);
     const S& shape_j = shape_of(problem_.shapes, sj);
     const RigidVelocity vi = rigid_velocity(V, si, dofs_), vj = rigid_velocity(V, sj, dofs_);
     const Pose start_j = shifted(problem_.poses[sj], image_shift);
-    const SweptDistance first = first_time_below(shape_i, problem_.poses[si], vi, shape_j, start_j, vj, problem_.dt,
-                                                 problem_.d_hat, 1e-3 * problem_.d_hat);
-    const Pose at_i = advance(problem_.poses[si], vi.u, vi.omega, first.time);
-    const Pose at_j = advance(start_j, vj.u, vj.omega, first.time);
-    return {at_i.to_body(first.points.curve_point_a), at_j.to_body(first.points.curve_point_b), first.points.normal,
-            shape_i.radius, shape_j.radius, first.time};
+    const double tolerance = 1e-3 * problem_.d_hat;
+    const SweptDistance found =
+        interior ? swept_minimum(shape_i, problem_.poses[si], vi, shape_j, start_j, vj, problem_.dt, tolerance)
+                 : first_time_below(shape_i, problem_.poses[si], vi, shape_j, start_j, vj, problem_.dt,
+                                    problem_.d_hat, tolerance);
+    const Pose at_i = advance(problem_.poses[si], vi.u, vi.omega, found.time);
+    const Pose at_j = advance(start_j, vj.u, vj.omega, found.time);
+    return {at_i.to_body(found.points.curve_point_a), at_j.to_body(found.points.curve_point_b), found.points.normal,
+            shape_i.radius, shape_j.radius, found.time, interior};
   }
+
+  // The carried contact of pair i, j on the motion with velocities V measured at the end
+  // (`at_end`: the configuration there) or, for an interior contact, at its own time, its
+  // distance then raised by interior_offset() (the interior bound is half of d_hat).
+  ContactPair carried_at(const CarriedContact& c, const ContactPair& p, const VecX& V,
+                         std::span<const Pose> at_end) const {
+    if (!c.interior) return carried_pair(c, p.i, p.j, p.image_shift, at_end);
+    const auto [pose_i, pose_j] = poses_at(p, V, c.time);
+    ContactPair out = carried_pair(c, p.i, p.j, p.image_shift, pose_i, pose_j);
+    out.points.distance += interior_offset();
+    return out;
+  }
+
+  // Bodies i and j (j as its image) of pair p at time t on the motion with velocities V.
+  std::pair<Pose, Pose> poses_at(const ContactPair& p, const VecX& V, double t) const {
+    const auto i = static_cast<std::size_t>(p.i), j = static_cast<std::size_t>(p.j);
+    const RigidVelocity vi = rigid_velocity(V, i, dofs_), vj = rigid_velocity(V, j, dofs_);
+    return {advance(problem_.poses[i], vi.u, vi.omega, t),
+            advance(shifted(problem_.poses[j], p.image_shift), vj.u, vj.omega, t)};
+  }
+
+  // An interior contact's column at the motion with velocities V: the gradient of its gap at
+  // t_c, where only t_c of the correction has acted, so dt D_k^T M D lambda is its change
+  // (the gradient at the time, scaled by t_c / dt).
+  ContactColumn interior_column(const CarriedContact& c, const ContactPair& p, const VecX& V) const {
+    const auto [pose_i, pose_j] = poses_at(p, V, c.time);
+    const ContactPair at = carried_pair(c, p.i, p.j, p.image_shift, pose_i, pose_j);
+    ContactColumn column{p.i, p.j};
+    detail::add_distance_gradient(column, at.points.normal, at.points.point_a - pose_i.x,
+                                  at.points.point_b - pose_j.x, c.time / problem_.dt);
+    return column;
+  }
+
+  // Inside the step a pair need only stay apart: an interior contact holds its gap at d_hat
+  // less this, half of d_hat (clear of the whole-step check's overlap threshold).
+  double interior_offset() const { return 0.5 * problem_.d_hat; }
 
   const SurfaceNodes& nodes_of(std::size_t body) const { return nodes_.size() == 1 ? nodes_[0] : nodes_[body]; }
 

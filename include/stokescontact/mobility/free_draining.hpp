@@ -199,7 +199,12 @@ class FreeDrainingMobility {
     if (!((n - n.transpose()).cwiseAbs().maxCoeff() <= kSymmetryTolerance * scale))
       fail_argument(field, "must be symmetric");
     const Mat6 sym = 0.5 * (n + n.transpose());
-    const double min_eigenvalue = Eigen::SelfAdjointEigenSolver<Mat6>(sym, Eigen::EigenvaluesOnly).eigenvalues()(0);
+    // The dynamic-size solver on purpose: SelfAdjointEigenSolver is one of Eigen's costliest
+    // templates to compile (seconds per instantiation), and the MatX one is the instantiation
+    // the rest of the library (defect correction, Lanczos) and the tests already use, so a
+    // translation unit pays for it once, not once per fixed size. Same algorithm, 6x6.
+    const double min_eigenvalue =
+        Eigen::SelfAdjointEigenSolver<MatX>(MatX(sym), Eigen::EigenvaluesOnly).eigenvalues()(0);
     if (!(min_eigenvalue > 0.0))
       fail_argument(field, "must be positive definite, smallest eigenvalue " + std::to_string(min_eigenvalue));
     return sym;
