@@ -2,8 +2,11 @@
 // number of pushed pairs, where the working set is one connected cluster.
 //
 //   dense_contact_networks [--part ball,jammed] [--spheres 1000] [--steps 300] [--phi 0.45,0.5,0.55,0.6]
-//                          [--solvers default,lcp-newton,lcp-bbpgd,lcp-apgd] [--output FILE]
+//                          [--solvers default,lcp-newton,lcp-bbpgd,lcp-apgd] [--cost blocks,matrix-free]
+//                          [--output FILE]
 //
+// Each part runs once per cost mode (contact_step.hpp: blocks forms M D from the free-draining
+// bodies' blocks, matrix-free applies M).
 // ball: N unit spheres (random sequential addition, phi 0.3, seed 1) driven towards their
 //   centroid by |f| = 20, free draining, dt = d_hat = 0.01, forward Euler with the default
 //   solver for --steps steps: the network grows as the ball compacts. Per step: pushed pairs,
@@ -30,7 +33,8 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: dense_contact_networks [--part ball,jammed] [--spheres 1000] [--steps 300] [--phi 0.45,0.5,0.55,0.6]\n"
-    "                              [--solvers default,lcp-newton,lcp-bbpgd,lcp-apgd] [--output FILE]\n";
+    "                              [--solvers default,lcp-newton,lcp-bbpgd,lcp-apgd] [--cost blocks,matrix-free]\n"
+    "                              [--output FILE]\n";
 
 const std::vector<sc::Sphere> kShapes{sc::Sphere{1.0}};
 
@@ -45,7 +49,8 @@ std::size_t pushed_pairs(const sc::ContactStepResult& r) {
 }
 
 std::string record(const char* part, const std::string& solver, const sc::ContactStepResult& r) {
-  return std::string("{\"part\": \"") + part + "\", \"solver\": \"" + solver + "\", \"flagged_pairs\": " +
+  return std::string("{\"part\": \"") + part + "\", \"solver\": \"" + solver + "\", \"cost\": \"" +
+         sc::mobility_cost_name(r.cost) + "\", \"flagged_pairs\": " +
          std::to_string(r.flagged_pairs) + ", \"pushed_pairs\": " + std::to_string(pushed_pairs(r)) +
          ", \"mobility_applications\": " + std::to_string(r.mobility_applications) + ", \"iterations\": " +
          std::to_string(r.iterations) + ", \"wall_time_s\": " + sc::json_number(r.wall_time_s) +
@@ -54,12 +59,12 @@ std::string record(const char* part, const std::string& solver, const sc::Contac
          sc::json_number(r.lambda_sum) + ", \"status\": \"" + std::string(sc::to_string(r.status)) + "\"";
 }
 
-bool ball(ex::JsonLines& sink, std::size_t n, int steps) {
+bool ball(ex::JsonLines& sink, std::size_t n, int steps, sc::MobilityCost mode) {
   const double dt = 0.01, d_hat = 0.01, force = 20.0;
   std::vector<sc::Pose> poses = sc::random_sequential_addition(n, 0.3, 1).poses;
   sc::FreeDrainingMobility mobility(sc::sphere_mobility(kShapes[0], 1.0), n, 3);
   sc::ContactStepOptions options;
-  options.cost = sc::MobilityCost::matrix_free;
+  options.cost = mode;
   std::vector<std::pair<std::size_t, double>> cost;  // (pushed pairs, wall time)
   bool ok = true;
   for (int step = 0; step < steps; ++step) {
@@ -80,9 +85,9 @@ bool ball(ex::JsonLines& sink, std::size_t n, int steps) {
     }
     poses = r.poses;
   }
-  std::printf("\nBall: %zu spheres driven inward, |f| = %g, free draining, dt = d_hat = %g, default solver\n"
+  std::printf("\nBall: %zu spheres driven inward, |f| = %g, free draining, dt = d_hat = %g, default solver, %s\n"
               "%17s | %5s | %12s | %16s\n",
-              n, force, dt, "pushed pairs", "steps", "median time", "time / pushed");
+              n, force, dt, sc::mobility_cost_name(mode), "pushed pairs", "steps", "median time", "time / pushed");
   std::sort(cost.begin(), cost.end());
   const std::size_t largest = cost.empty() ? 0 : cost.back().first;
   const std::size_t band = std::max<std::size_t>(1, (largest + 5) / 6);
@@ -100,11 +105,12 @@ bool ball(ex::JsonLines& sink, std::size_t n, int steps) {
   return ok;
 }
 
-bool jammed(ex::JsonLines& sink, std::size_t n, const std::vector<double>& phis, const std::vector<std::string>& solvers) {
+bool jammed(ex::JsonLines& sink, std::size_t n, const std::vector<double>& phis, const std::vector<std::string>& solvers,
+            sc::MobilityCost mode) {
   const double dt = 0.01, d_hat = 1e-4, force = 100.0;
-  std::printf("\nJammed packings: %zu spheres, |f| = %g, free draining, dt = %g, d_hat = %g, matrix free\n"
+  std::printf("\nJammed packings: %zu spheres, |f| = %g, free draining, dt = %g, d_hat = %g, %s\n"
               "%6s %6s | %-11s | %7s %7s | %6s %5s | %10s | %12s | %9s | %s\n",
-              n, force, dt, d_hat, "phi", "gap", "solver", "Nc", "pushed", "apps", "its", "wall", "min d/d_hat",
+              n, force, dt, d_hat, sc::mobility_cost_name(mode), "phi", "gap", "solver", "Nc", "pushed", "apps", "its", "wall", "min d/d_hat",
               "compl.", "status");
   bool ok = true;
   for (const double phi : phis) {
@@ -117,7 +123,7 @@ bool jammed(ex::JsonLines& sink, std::size_t n, const std::vector<double>& phis,
       const sc::VecX U = mobility.apply(F);
       const sc::ContactStepProblem<sc::Sphere> problem{kShapes, packing.poses, U, dt, d_hat};
       sc::ContactStepOptions options;
-      options.cost = sc::MobilityCost::matrix_free;
+      options.cost = mode;
       const sc::ContactStepResult r =
           sc::solve_contact_step(problem, mobility, options, sc::contact_solver_from_name(name));
       sink.line(record("jammed", name, r) + ", \"phi\": " + sc::json_number(packing.phi) + ", \"min_gap\": " +
@@ -142,6 +148,7 @@ struct Options {
   int steps = 300;
   std::vector<double> phis;
   std::vector<std::string> solvers;
+  std::vector<sc::MobilityCost> costs;
   std::string output;
 };
 
@@ -157,6 +164,8 @@ Options parse(int argc, char** argv) {
   o.phis = args.numbers("--phi", {0.45, 0.5, 0.55, 0.6}, 0.0);
   o.solvers = args.list("--solvers", {"default", "lcp-newton", "lcp-bbpgd", "lcp-apgd"});
   for (const std::string& s : o.solvers) sc::contact_solver_from_name(s);
+  for (const std::string& c : args.list("--cost", {"blocks", "matrix-free"}))
+    o.costs.push_back(sc::mobility_cost_from_name(c, "--cost"));
   o.output = args.text("--output", "");
   args.reject_unknown();
   return o;
@@ -167,7 +176,8 @@ int run(const Options& o) {
   ex::JsonLines sink(o.output);
   bool ok = true;
   for (const std::string& part : o.parts)
-    ok = (part == "ball" ? ball(sink, o.spheres, o.steps) : jammed(sink, o.spheres, o.phis, o.solvers)) && ok;
+    for (const sc::MobilityCost cost : o.costs)
+      ok = (part == "ball" ? ball(sink, o.spheres, o.steps, cost) : jammed(sink, o.spheres, o.phis, o.solvers, cost)) && ok;
   return ok ? 0 : 1;
 }
 

@@ -61,11 +61,7 @@ struct Options {
   bool table1 = false;
 };
 
-sc::MobilityCost parse_cost(const std::string& name) {
-  if (name == "formed") return sc::MobilityCost::formed;
-  if (name == "matrix-free") return sc::MobilityCost::matrix_free;
-  throw std::invalid_argument("--cost must be formed or matrix-free, got '" + name + "'");
-}
+sc::MobilityCost parse_cost(const std::string& name) { return sc::mobility_cost_from_name(name, "--cost"); }
 
 Options parse(int argc, char** argv) {
   ex::Arguments args(argc, argv);
@@ -98,7 +94,7 @@ Options parse(int argc, char** argv) {
 }
 
 const char* cost_name(const Options& o) {
-  return o.step.options.cost == sc::MobilityCost::formed ? "formed" : "matrix-free";
+  return sc::mobility_cost_name(o.step.options.cost);
 }
 
 ex::SceneSpec fig4_scene(const Options& o, double phi) {

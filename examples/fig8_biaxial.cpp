@@ -7,7 +7,7 @@
 //                [--rows 5] [--columns 6] [--spacing-y 1.5] [--spacing-z 3]
 //                [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
 //                [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]
-//                [--line-angle 0.05] [--cost formed|matrix-free] [--max-steps N] [--tilt 0]
+//                [--line-angle 0.05] [--cost formed|matrix-free|blocks|automatic] [--max-steps N] [--tilt 0]
 //                [--max-iterations N] [--output FILE]
 //
 // --d-hat is in units of R_rod. --directions: the paper's d^P ("particle", eq. 20-21) and d^S
@@ -52,7 +52,7 @@ constexpr const char* kUsage =
     "                    [--columns 6] [--spacing-y 1.5] [--spacing-z 3] [--solver NAME]\n"
     "                    [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
     "                    [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]\n"
-    "                    [--line-angle 0.05] [--cost formed|matrix-free] [--max-steps N] [--tilt 0]\n"
+    "                    [--line-angle 0.05] [--cost formed|matrix-free|blocks|automatic] [--max-steps N] [--tilt 0]\n"
     "                    [--max-iterations N] [--output FILE]\n";
 
 constexpr double kLRod = 2.0, kRRod = kLRod / 4.0;  // Sec. 3.2.3
@@ -92,9 +92,7 @@ Options parse(int argc, char** argv) {
   o.line_width = args.number("--line-width", 2.0 * kRRod, 1e-12);
   o.line_angle = args.number("--line-angle", 0.05, 1e-12);
   o.step.node_spacing = args.number("--node-spacing", 0.0, 0.0);
-  const std::string cost = args.text("--cost", "formed");
-  if (cost != "formed" && cost != "matrix-free") throw std::invalid_argument("--cost must be formed or matrix-free");
-  o.step.cost = cost == "formed" ? sc::MobilityCost::formed : sc::MobilityCost::matrix_free;
+  o.step.cost = sc::mobility_cost_from_name(args.text("--cost", "formed"), "--cost");
   o.max_steps = static_cast<long>(args.integer("--max-steps", 0, 0));
   o.tilt = args.number("--tilt", 0.0);
   // The solver's iteration limit per round (LCPs of the LCP sequence, corrections of the

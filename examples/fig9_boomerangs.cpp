@@ -8,7 +8,7 @@
 //
 //   fig9_boomerangs [--configs 200] [--seed 1] [--boomerangs 40] [--side 12] [--min-gap 1e-2]
 //                   [--solver NAME] [--mobility free-draining|multiblob] [--blob-model curve|surface]
-//                   [--blob-spacing H] [--cost formed|matrix-free] [--directions surface|particle] [--output FILE]
+//                   [--blob-spacing H] [--cost formed|matrix-free|blocks|automatic] [--directions surface|particle] [--output FILE]
 //   fig9_boomerangs --resolution [--spacings 0.5,0.35,0.25,0.18,0.125] [--reference-spacing 0.09]
 //
 // Prints one JSON object per configuration (to --output if given, else stdout), then a summary.
@@ -42,7 +42,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: fig9_boomerangs [--configs 200] [--seed 1] [--boomerangs 40] [--side 12] [--min-gap 1e-2]\n"
     "                       [--solver NAME] [--mobility free-draining|multiblob] [--blob-model curve|surface]\n"
-    "                       [--blob-spacing H] [--cost formed|matrix-free] [--directions surface|particle] [--output FILE]\n"
+    "                       [--blob-spacing H] [--cost formed|matrix-free|blocks|automatic] [--directions surface|particle] [--output FILE]\n"
     "       fig9_boomerangs --resolution [--spacings 0.5,0.35,0.25,0.18,0.125] [--reference-spacing 0.09]\n";
 
 constexpr double kTimeStep = 0.01;
@@ -81,10 +81,7 @@ Options parse(int argc, char** argv) {
   if (o.blob_model != "curve" && o.blob_model != "surface")
     throw std::invalid_argument("--blob-model must be curve or surface, got '" + o.blob_model + "'");
   o.blob_spacing = args.number("--blob-spacing", o.blob_model == "surface" ? 0.25 : 0.0, 0.0);
-  const std::string cost = args.text("--cost", "matrix-free");
-  if (cost != "formed" && cost != "matrix-free")
-    throw std::invalid_argument("--cost must be formed or matrix-free, got '" + cost + "'");
-  o.step.cost = cost == "formed" ? sc::MobilityCost::formed : sc::MobilityCost::matrix_free;
+  o.step.cost = sc::mobility_cost_from_name(args.text("--cost", "matrix-free"), "--cost");
   const std::string directions = args.text("--directions", "surface");
   if (directions != "surface" && directions != "particle")
     throw std::invalid_argument("--directions must be surface or particle, got '" + directions + "'");

@@ -77,12 +77,10 @@ ex::SceneSpec parse_scene(const std::string& name, std::size_t spheres, std::siz
 
 std::vector<sc::MobilityCost> parse_costs(const std::string& name) {
   if (name == "both") return {sc::MobilityCost::formed, sc::MobilityCost::matrix_free};
-  if (name == "formed") return {sc::MobilityCost::formed};
-  if (name == "matrix-free") return {sc::MobilityCost::matrix_free};
-  throw std::invalid_argument("--cost must be both, formed or matrix-free, got '" + name + "'");
+  return {sc::mobility_cost_from_name(name, "--cost (or both)")};
 }
 
-const char* cost_name(sc::MobilityCost c) { return c == sc::MobilityCost::formed ? "formed" : "matrix-free"; }
+const char* cost_name(sc::MobilityCost c) { return sc::mobility_cost_name(c); }
 
 Options parse(int argc, char** argv) {
   ex::Arguments args(argc, argv);

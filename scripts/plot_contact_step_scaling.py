@@ -29,7 +29,7 @@ def load(paths):
 def main(paths, out):
     rows = load(paths)
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
-    for cost, marker in (("matrix-free", "o"), ("formed", "s")):
+    for cost, marker in (("blocks", "D"), ("matrix-free", "o"), ("formed", "s")):
         pts = sorted((r["N"], r["contact_step_s"]) for r in rows if r["cost"] == cost)
         if not pts:
             continue

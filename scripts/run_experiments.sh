@@ -64,14 +64,16 @@ for part in "${parts[@]}"; do
         done
       done
       /usr/bin/python3 scripts/plot_fig8.py docs/figures/fig8_biaxial.png $data/fig8_free_draining_*.jsonl ;;
-    scale)  # 1e3-1e6 spheres, one process per cost mode (peak memory is per process); ~2 minutes
+    scale)  # 1e3-1e6 spheres, one process per cost mode (peak memory is per process); ~3 minutes
       mkdir -p $data/scaling
+      $bin/contact_step_scaling --sizes 1000,3000,10000,30000,100000,300000,1000000 --cost blocks \
+        --output $data/scaling/blocks.jsonl | tee $data/scaling/contact_step_scaling.txt
       $bin/contact_step_scaling --sizes 1000,3000,10000,30000,100000,300000,1000000 --cost matrix-free \
-        --output $data/scaling/matrix_free.jsonl | tee $data/scaling/contact_step_scaling.txt
+        --output $data/scaling/matrix_free.jsonl | tee -a $data/scaling/contact_step_scaling.txt
       $bin/contact_step_scaling --sizes 1000,3000,10000,30000 --cost formed --formed-max 30000 \
         --output $data/scaling/formed.jsonl | tee -a $data/scaling/contact_step_scaling.txt
-      cat $data/scaling/matrix_free.jsonl $data/scaling/formed.jsonl > $data/scaling/contact_step_scaling.jsonl
-      rm $data/scaling/matrix_free.jsonl $data/scaling/formed.jsonl
+      cat $data/scaling/{blocks,matrix_free,formed}.jsonl > $data/scaling/contact_step_scaling.jsonl
+      rm $data/scaling/{blocks,matrix_free,formed}.jsonl
       /usr/bin/python3 scripts/plot_contact_step_scaling.py $data/scaling/contact_step_scaling.jsonl \
         docs/figures/contact_step_scaling.png
       run scaling/dense_contact_networks $bin/dense_contact_networks ;;

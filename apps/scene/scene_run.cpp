@@ -131,6 +131,9 @@ void step_scene(const SceneSpec& spec, const S& shape, std::vector<Pose> poses, 
   BlockAverage stress_average, pressure_average;
   stepper.add_contact_observer([&](const ContactStepProblem<S>& p, const ContactStepResult& r) {
     step_stress += (p.dt / spec.dt) * contact_step_stress(p, r);
+    const std::string cost = mobility_cost_name(r.cost);
+    if (("," + summary.contact_cost + ",").find("," + cost + ",") == std::string::npos)
+      summary.contact_cost += (summary.contact_cost.empty() ? "" : ",") + cost;
   });
   Progress progress(steps, progress_on);
   stepper.add_step_observer([&](const StepDiagnostics& d, std::span<const Pose> q) {
@@ -262,8 +265,10 @@ void print_summary(const RunSummary& s, std::ostream& out) {
   out << line;
   std::snprintf(line, sizeof line, "min d/d_hat %.6f (step %lld)\n", s.min_distance_ratio, s.min_distance_step);
   out << line;
-  std::snprintf(line, sizeof line, "mobility   %zu applications in all, per step median %zu, max %zu\n",
-                s.applications_total, s.applications_median, s.applications_max);
+  std::snprintf(line, sizeof line, "mobility   %zu applications in all, per step median %zu, max %zu%s%s%s\n",
+                s.applications_total, s.applications_median, s.applications_max,
+                s.contact_cost.empty() ? "" : " (contact cost mode: ", s.contact_cost.c_str(),
+                s.contact_cost.empty() ? "" : ")");
   out << line;
   if (s.steps_done >= 2) {
     std::snprintf(line, sizeof line, "collisions pressure %.6g +- %.2g (time average of Yan eq. 16 summed over pairs, "

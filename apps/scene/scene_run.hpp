@@ -44,6 +44,9 @@ struct RunSummary {
   double min_distance_ratio = std::numeric_limits<double>::infinity();
   long long min_distance_step = 0;
   std::size_t applications_total = 0, applications_median = 0, applications_max = 0;
+  // The contact steps' cost modes (ContactStepResult::cost, automatic resolved), comma-separated
+  // in the order first used; empty before any contact step.
+  std::string contact_cost;
   double wall_time_s = 0.0;
   // The collision stress per step (Yan eq. 16 summed over the step's pairs: force x length,
   // not divided by a volume), averaged over the run with block-averaging error bars
@@ -68,7 +71,8 @@ struct RunSummary {
            ", \"min_distance_step\": " + std::to_string(min_distance_step) +
            ", \"applications_total\": " + std::to_string(applications_total) +
            ", \"applications_median\": " + std::to_string(applications_median) +
-           ", \"applications_max\": " + std::to_string(applications_max) + ", \"wall_time_s\": " + json_number(wall_time_s) +
+           ", \"applications_max\": " + std::to_string(applications_max) +
+           ", \"contact_cost\": " + json_quoted(contact_cost) + ", \"wall_time_s\": " + json_number(wall_time_s) +
            ", \"frames\": " + std::to_string(frames) + ", \"collision_stress_mean\": " + row_major(collision_stress_mean) +
            ", \"collision_stress_error\": " + row_major(collision_stress_error) +
            ", \"collision_pressure_mean\": " + json_number(collision_pressure_mean) +

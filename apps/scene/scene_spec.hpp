@@ -266,7 +266,7 @@ inline ContactSpec read_contact(const JsonReader& r, const SceneShape& shape) {
       d->fail("'overlap-ends' holds near-parallel rods at both ends of their overlap: spherocylinders only");
   }
   if (const auto cost = r.find("cost"))
-    c.step.cost = cost->choice({"formed", "matrix-free"}) == "formed" ? MobilityCost::formed : MobilityCost::matrix_free;
+    c.step.cost = mobility_cost_from_name(cost->choice({"automatic", "formed", "matrix-free", "blocks"}), "cost");
   if (const auto s = r.find("node_spacing")) c.step.node_spacing = s->non_negative();
   if (const auto w = r.find("whole_step")) c.step.whole_step = w->boolean();
   if (const auto m = r.find("separation_margin")) {

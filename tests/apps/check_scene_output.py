@@ -54,6 +54,8 @@ check(summary["applications_total"] == sum(s["mobility_applications"] for s in s
 check(math.isclose(summary["min_distance_ratio"], min(s["min_distance_ratio"] for s in steps), rel_tol=1e-12),
       "summary's min d / d_hat differs from the step log's")
 check(summary["min_distance_ratio"] >= 1 - 1e-3, "min d / d_hat %g below the margin" % summary["min_distance_ratio"])
+# The scene leaves contact.cost at automatic and its model is free draining: the blocks mode.
+check(summary["contact_cost"] == "blocks", "contact cost mode %r, expected blocks" % summary["contact_cost"])
 
 stress = [json.loads(line) for line in open(os.path.join(out_dir, "stress.jsonl"))]
 check(len(stress) == len(steps), "stress.jsonl has %d lines for %d steps" % (len(stress), len(steps)))

@@ -16,6 +16,7 @@
 #include "stokescontact/contact/solvers/defect_correction.hpp"
 #include "stokescontact/contact/solvers/lcp_sequence.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
+#include "stokescontact/mobility/rpy_mobility.hpp"
 
 namespace sc = stokescontact;
 
@@ -143,8 +144,8 @@ TEST(ContactStep, TwoSpheresHeadOnMatchClosedFormForEverySolver) {
   const double d_star = 0.1 - 2.0 * 10.0 * s.dt;
   const double lambda_star = (s.d_hat - d_star) / (2.0 * kMu * s.dt);
   for (const Solver solver : kAllSolvers)
-    for (const sc::MobilityCost cost : {sc::MobilityCost::formed, sc::MobilityCost::matrix_free}) {
-      SCOPED_TRACE(solver_name(solver) + (cost == sc::MobilityCost::formed ? " formed" : " matrix_free"));
+    for (const sc::MobilityCost cost : {sc::MobilityCost::formed, sc::MobilityCost::matrix_free, sc::MobilityCost::blocks}) {
+      SCOPED_TRACE(solver_name(solver) + " " + sc::mobility_cost_name(cost));
       auto m = s.mobility();
       sc::ContactStepOptions options;
       options.cost = cost;
@@ -164,8 +165,11 @@ TEST(ContactStep, TwoSpheresHeadOnMatchClosedFormForEverySolver) {
       EXPECT_NEAR(r.velocities(0), 10.0 - kMu * r.lambda(0), 1e-12 * lambda_star);
       EXPECT_DOUBLE_EQ(r.barrier_energy, r.barrier_energy);  // finite
       expect_third_law(r, 3);
+      EXPECT_EQ(r.cost, cost);
       if (cost == sc::MobilityCost::formed) {
         EXPECT_EQ(r.mobility_applications, 1u);  // M D, Nc = 1 column
+      } else if (cost == sc::MobilityCost::blocks) {
+        EXPECT_EQ(r.mobility_applications, 0u);  // M D from the blocks
       } else {
         EXPECT_GE(r.mobility_applications, 1u);
       }
@@ -305,19 +309,30 @@ TEST(ContactStep, SolversAgreeOnRodScenes) {
       EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
       EXPECT_GE(r.min_distance_ratio, is_default ? 1.0 - 1e-9 : 1.0 - 1e-3);
       EXPECT_NEAR(r.lambda_sum, reference, 1e-2 * reference);
-      // formed: at most the Nc columns of M D, each formed on first need.
-      EXPECT_GE(r.mobility_applications, 1u);
-      EXPECT_LE(r.mobility_applications, r.flagged_pairs);
+      // The default cost mode for free draining: M D from the blocks, no application.
+      EXPECT_EQ(r.cost, sc::MobilityCost::blocks);
+      EXPECT_EQ(r.mobility_applications, 0u);
       expect_third_law(r, 6);
-      // matrix_free: the same step, one application per M D lambda (and per gradient / A x).
-      sc::FreeDrainingMobility m(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
-      sc::ContactStepOptions options;
-      options.cost = sc::MobilityCost::matrix_free;
-      const sc::ContactStepResult free = run(kSceneSolvers[k], p, m, options);
-      print("rods seed " + std::to_string(seed) + " matrix_free", kSceneSolvers[k], free);
-      EXPECT_EQ(free.status, sc::ContactStepStatus::converged) << free.message;
-      EXPECT_NEAR(free.lambda_sum, r.lambda_sum,
-                  (is_barrier(kSceneSolvers[k]) ? 1e-3 : is_default ? kDefaultLambdaTolerance : 1e-6) * r.lambda_sum);
+      // formed (at most the Nc columns of M D, each formed on first need) and matrix_free (one
+      // application per M D lambda and per gradient / A x): the same step.
+      for (const sc::MobilityCost cost : {sc::MobilityCost::formed, sc::MobilityCost::matrix_free}) {
+        sc::FreeDrainingMobility m(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
+        sc::ContactStepOptions options;
+        options.cost = cost;
+        const sc::ContactStepResult other = run(kSceneSolvers[k], p, m, options);
+        print("rods seed " + std::to_string(seed) + " " + sc::mobility_cost_name(cost), kSceneSolvers[k], other);
+        EXPECT_EQ(other.status, sc::ContactStepStatus::converged) << other.message;
+        EXPECT_GE(other.mobility_applications, 1u);
+        if (cost == sc::MobilityCost::formed) {
+          EXPECT_LE(other.mobility_applications, other.flagged_pairs);
+        }
+        const double exact_model = cost == sc::MobilityCost::formed ? 1e-6 : 0.0;  // formed and blocks: one model
+        EXPECT_NEAR(other.lambda_sum, r.lambda_sum,
+                    (exact_model > 0.0 ? exact_model
+                     : is_barrier(kSceneSolvers[k]) ? 1e-3
+                     : is_default                   ? kDefaultLambdaTolerance
+                                                    : 1e-6) * r.lambda_sum);
+      }
     }
   }
 }
@@ -376,6 +391,41 @@ TEST(ContactStep, DenseSceneWithSmallDTryIsSeparatedByTheGuaranteeLoop) {
     EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
     expect_third_law(r, 3);
   }
+}
+
+// The cost mode follows the model: blocks for a block-diagonal one (free draining); for any
+// other, formed up to automatic_formed_max_pairs flagged pairs and matrix_free beyond. blocks
+// asked of a model without blocks is refused, naming the option.
+TEST(ContactStep, AutomaticCostModeFollowsTheModelAndBlocksNeedsBlocks) {
+  const SphereScene s = random_spheres(12, 30, 8.0, 10.0);
+  auto free_draining = s.mobility();
+  const sc::ContactStepResult blocks = sc::solve_contact_step_defect_correction(s.problem(), free_draining);
+  EXPECT_EQ(blocks.cost, sc::MobilityCost::blocks);
+  EXPECT_EQ(blocks.mobility_applications, 0u);
+  ASSERT_GT(blocks.lambda_max, 0.0);
+  auto again = s.mobility();
+  sc::ContactStepOptions formed_options;
+  formed_options.cost = sc::MobilityCost::formed;
+  const sc::ContactStepResult formed = sc::solve_contact_step_defect_correction(s.problem(), again, formed_options);
+  EXPECT_GT(formed.mobility_applications, 0u);
+  ASSERT_EQ(formed.lambda.size(), blocks.lambda.size());
+  EXPECT_LE((formed.lambda - blocks.lambda).norm(), 1e-10 * blocks.lambda.norm());  // one exact model, two ways
+
+  sc::RpyMobility rpy(s.poses.size(), {1.0, 1.0}, 3);
+  const sc::ContactStepResult many = sc::solve_contact_step_defect_correction(s.problem(), rpy);
+  ASSERT_GT(many.flagged_pairs, 8u);
+  EXPECT_EQ(many.cost, sc::MobilityCost::matrix_free);
+  sc::ContactStepOptions few;
+  few.automatic_formed_max_pairs = many.flagged_pairs;
+  const sc::ContactStepResult formed_rpy = sc::solve_contact_step_defect_correction(s.problem(), rpy, few);
+  EXPECT_EQ(formed_rpy.cost, sc::MobilityCost::formed);
+  EXPECT_NEAR(formed_rpy.lambda_sum, many.lambda_sum, kDefaultLambdaTolerance * many.lambda_sum);
+  sc::ContactStepOptions options;
+  options.cost = sc::MobilityCost::blocks;
+  expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(s.problem(), rpy, options); },
+                 "ContactStepOptions.cost");
+  EXPECT_EQ(sc::mobility_cost_from_name("matrix-free", "cost"), sc::MobilityCost::matrix_free);
+  expect_rejects([] { (void)sc::mobility_cost_from_name("sparse", "contact.cost"); }, "contact.cost");
 }
 
 TEST(ContactStep, RejectsBadInputNamingTheFieldAndChangesNothing) {

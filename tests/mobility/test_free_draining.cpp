@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include <Eigen/SparseCore>
+
 #include "stokescontact/mobility/free_draining.hpp"
 #include "mobility/mobility_checks.hpp"
 
@@ -134,6 +136,31 @@ TEST(FreeDrainingMobility, ApplyEqualsDenseMatrixAndCountsApplications) {
     sc::FreeDrainingMobility m = mixed_scene(40, dofs, rng);
     m.set_configuration(random_poses(40, 0.0, 5.0, rng));
     mobility_checks::expect_apply_matches_dense(m, rng, 1e-13);
+  }
+}
+
+// The sparse form (BlockDiagonalMobility, the contact step's blocks mode): the same products
+// as apply, body blocks only, and no application counted.
+TEST(FreeDrainingMobility, BlockDiagonalMatchesApplyWithoutApplications) {
+  static_assert(sc::BlockDiagonalMobility<sc::FreeDrainingMobility>);
+  sc::Rng rng(kSeed + 2);
+  for (int dofs : {3, 6}) {
+    SCOPED_TRACE("seed " + std::to_string(kSeed + 2) + ", dofs " + std::to_string(dofs));
+    sc::FreeDrainingMobility m = mixed_scene(40, dofs, rng);
+    m.set_configuration(random_poses(40, 0.0, 5.0, rng));
+    const Eigen::SparseMatrix<double> M = m.block_diagonal();
+    EXPECT_EQ(m.applications(), 0u);
+    ASSERT_EQ(M.rows(), m.size());
+    ASSERT_EQ(M.cols(), m.size());
+    EXPECT_LE(M.nonZeros(), 40 * dofs * dofs);
+    for (int k = 0; k < M.outerSize(); ++k)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(M, k); it; ++it)
+        EXPECT_EQ(it.row() / dofs, it.col() / dofs) << "entry (" << it.row() << ", " << it.col() << ") off the body blocks";
+    for (int trial = 0; trial < 3; ++trial) {
+      const sc::VecX F = random_vector(m.size(), rng);
+      const sc::VecX U = m.apply(F);
+      EXPECT_LE((sc::VecX(M * F) - U).norm(), 1e-13 * U.norm());
+    }
   }
 }
 

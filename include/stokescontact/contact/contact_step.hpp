@@ -13,12 +13,21 @@
 // contact's force over its node pairs.
 // A solver then looks for contact magnitudes lambda >= 0 so that the corrected configuration
 //     Q(lambda) = Q_t + dt Psi (U + M D lambda)        (eq. 13, M at Q_t)
-// keeps every pair at d >= d_hat. Two cost modes for M D lambda:
+// keeps every pair at d >= d_hat. Three cost modes for M D lambda:
 //   formed:      each column of M D is computed once, on first need (one application each:
 //                M D lambda needs the columns with lambda_k != 0, (M D)^T v all Nc of them);
-//                every product is then free;
-//   matrix_free: one application per distinct M D lambda and per D^T M v.
-// lambda = 0 costs nothing in both modes, so a step without contacts costs 0 applications.
+//                every product is then free; each column is held densely (N dofs);
+//   matrix_free: one application per distinct M D lambda and per D^T M v;
+//   blocks:      M D formed once, exactly and sparsely, from a block-diagonal model's blocks
+//                (BlockDiagonalMobility: free draining); no application at all, O(N + Nc)
+//                time and memory.
+// automatic (the default) takes blocks where the model offers them; otherwise formed for a
+// step with few flagged pairs (ContactStepOptions::automatic_formed_max_pairs: formed pays
+// one application per working-set pair, while the default solver matrix-free needs a median
+// of 4-6 on the Fig. 4 scenes, whatever their size) and matrix_free beyond, where formed
+// would pay hundreds of applications and hold a dense column per pair.
+// ContactStepResult::cost says which was used. lambda = 0 costs nothing in every mode, so a step
+// without contacts costs 0 applications.
 //
 // Pairs that pass through each other (or sweep past) in the trial step. A flagged pair whose
 // distance along the trial motion has its minimum inside the step, below min(d*, d_hat), ends
@@ -94,7 +103,24 @@ struct ContactStepProblem {
   DTryRule d_try_rule = DTryRule::relative;        // when d_try = 0: per pair (relative) or eq. 30/31
 };
 
-enum class MobilityCost { formed, matrix_free };
+enum class MobilityCost { automatic, formed, matrix_free, blocks };
+
+inline const char* mobility_cost_name(MobilityCost cost) {
+  switch (cost) {
+    case MobilityCost::automatic: return "automatic";
+    case MobilityCost::formed: return "formed";
+    case MobilityCost::matrix_free: return "matrix-free";
+    case MobilityCost::blocks: return "blocks";
+  }
+  return "unknown";
+}
+
+// The mode a driver or scene file names (mobility_cost_name's words); `field` names the input.
+inline MobilityCost mobility_cost_from_name(std::string_view name, std::string_view field) {
+  for (MobilityCost c : {MobilityCost::automatic, MobilityCost::formed, MobilityCost::matrix_free, MobilityCost::blocks})
+    if (name == mobility_cost_name(c)) return c;
+  fail_argument(field, "unknown cost mode '" + std::string(name) + "' (known: automatic, formed, matrix-free, blocks)");
+}
 
 // Where contact forces act: the closest points (eq. 21) or the surface-node pairs (eq. 23);
 // automatic: surface for non-convex shapes (boomerangs), particle for convex ones.
@@ -103,7 +129,9 @@ enum class MobilityCost { formed, matrix_free };
 enum class ContactDirections { automatic, particle, surface, overlap_ends };
 
 struct ContactStepOptions {
-  MobilityCost cost = MobilityCost::formed;
+  MobilityCost cost = MobilityCost::automatic;
+  // automatic without blocks: formed up to this many flagged pairs, matrix_free beyond.
+  std::size_t automatic_formed_max_pairs = 8;
   // A pair is separated when d >= d_hat (1 - separation_margin).
   double separation_margin = 1e-3;
   // Re-solves after adding pairs the trial step missed (the guarantee loop).
@@ -165,6 +193,7 @@ struct ContactStepResult {
   std::vector<Pose> poses;              // Q(lambda), the new configuration
   int iterations = 0;                   // solver iterations over all rounds (see each solver)
   std::size_t mobility_applications = 0;
+  MobilityCost cost = MobilityCost::formed;  // the cost mode used (automatic resolved)
   double wall_time_s = 0.0;
   double d_try = 0.0;                   // the threshold used
   double min_distance_ratio = 0.0;      // min d^P over all pairs of Q(lambda) / d_hat (inf: < 2 bodies)
@@ -251,6 +280,11 @@ class ContactStep {
     require_positive(problem.dt, "dt");
     require_positive(problem.d_hat, "d_hat");
     dofs_ = mobility.dofs_per_body();
+    cost_ = options.cost;
+    if (cost_ == MobilityCost::automatic && BlockDiagonalMobility<M>) cost_ = MobilityCost::blocks;
+    if (cost_ == MobilityCost::blocks && !BlockDiagonalMobility<M>)
+      fail_argument("ContactStepOptions.cost", "blocks needs a block-diagonal mobility (BlockDiagonalMobility, "
+                                               "e.g. FreeDrainingMobility); use formed or matrix_free");
     detail::require_velocities(problem.U, problem.poses.size(), dofs_);
     if (mobility.size() != static_cast<Eigen::Index>(problem.poses.size()) * dofs_)
       fail_argument("mobility", "has size " + std::to_string(mobility.size()) + ", expected " +
@@ -292,6 +326,8 @@ class ContactStep {
                                                  problem.d_try_multiplier);
       pairs_ = find_contact_pairs(problem.shapes, trial, d_try_, problem.box);
     }
+    if (cost_ == MobilityCost::automatic)
+      cost_ = pairs_.size() <= options.automatic_formed_max_pairs ? MobilityCost::formed : MobilityCost::matrix_free;
     carried_.assign(pairs_.size(), std::nullopt);
     if (options.whole_step)
       for (std::size_t k = 0; k < pairs_.size(); ++k) carry_if_passing(k);
@@ -300,6 +336,11 @@ class ContactStep {
     // Everything checked: only now touch the mobility.
     start_applications_ = mobility.applications();
     mobility.set_configuration(problem.poses);  // M at Q_t (eq. 13)
+    if constexpr (BlockDiagonalMobility<M>)
+      if (cost_ == MobilityCost::blocks) {
+        M_blocks_ = mobility.block_diagonal();
+        MD_ = M_blocks_ * D_;
+      }
   }
 
   // Adds pairs (i < j) not yet flagged, measured at Q*; returns how many were new. A pair
@@ -360,10 +401,11 @@ class ContactStep {
     return added;
   }
 
-  // M D lambda: free for lambda = 0 and for formed columns, else one application.
+  // M D lambda: free for lambda = 0, for formed columns and with blocks, else one application.
   VecX MD_times(const VecX& lambda) {
     if (lambda.isZero(0.0)) return VecX::Zero(mobility_.size());
-    if (options_.cost == MobilityCost::matrix_free) return mobility_.apply(VecX(D_ * lambda));
+    if (cost_ == MobilityCost::blocks) return MD_ * lambda;
+    if (cost_ == MobilityCost::matrix_free) return mobility_.apply(VecX(D_ * lambda));
     VecX out = VecX::Zero(mobility_.size());
     for (Eigen::Index k = 0; k < lambda.size(); ++k)
       if (lambda(k) != 0.0) out += lambda(k) * formed_column(k);
@@ -373,7 +415,8 @@ class ContactStep {
   // (M D)^T v = D^T M v (M symmetric): free once formed, else one application.
   VecX MD_transpose_times(const VecX& v) {
     if (v.isZero(0.0)) return VecX::Zero(nc());
-    if (options_.cost == MobilityCost::matrix_free) return D_.transpose() * mobility_.apply(v);
+    if (cost_ == MobilityCost::blocks) return MD_.transpose() * v;
+    if (cost_ == MobilityCost::matrix_free) return D_.transpose() * mobility_.apply(v);
     VecX out(nc());
     for (Eigen::Index k = 0; k < nc(); ++k) out(k) = formed_column(k).dot(v);
     return out;
@@ -394,17 +437,34 @@ class ContactStep {
   // Q with velocities U + MD_lambda (M D lambda already known, e.g. scaled along a ray) and
   // the flagged pairs measured there, as evaluate() does (carried contacts by their gap);
   // no mobility application, nothing cached. `lambda` is left empty.
+  // A body on which M D lambda is exactly zero (every body outside the pushed pairs of a local
+  // model such as free draining) moves as in the trial step: it keeps its pose at Q*, and a
+  // pair of two such bodies its measurement at Q* (at_trial_), the same numbers as computing
+  // them again. So an evaluation costs O(N) copies plus the pairs near pushed bodies.
   ContactEvaluation measure(VecX MD_lambda) const {
     ContactEvaluation e;
     e.MD_lambda = std::move(MD_lambda);
     const VecX V = problem_.U + e.MD_lambda;
-    e.poses = advance_all(problem_.poses, V, dofs_, problem_.dt);  // eq. 13
+    const auto n = problem_.poses.size();
+    std::vector<char> moved(n, 0);
+    e.poses = trial_;
+    for (std::size_t b = 0; b < n; ++b) {
+      const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs_;
+      if (e.MD_lambda.segment(row, dofs_).isZero(0.0)) continue;
+      moved[b] = 1;
+      const Vec3 omega = dofs_ == 6 ? Vec3(V.segment<3>(row + 3)) : Vec3::Zero();
+      e.poses[b] = advance(problem_.poses[b], V.segment<3>(row), omega, problem_.dt);  // eq. 13
+    }
     e.pairs.reserve(pairs_.size());
     e.distances.resize(nc());
     for (std::size_t k = 0; k < pairs_.size(); ++k) {
       const ContactPair& p = pairs_[k];
-      e.pairs.push_back(carried_[k] ? carried_at(*carried_[k], p, V, std::span<const Pose>(e.poses))
-                                    : remeasured(p, problem_.shapes, std::span<const Pose>(e.poses), problem_.box));
+      if (carried_[k])
+        e.pairs.push_back(carried_at(*carried_[k], p, V, std::span<const Pose>(e.poses)));
+      else if (k < at_trial_.size() && !moved[static_cast<std::size_t>(p.i)] && !moved[static_cast<std::size_t>(p.j)])
+        e.pairs.push_back(at_trial_[k]);
+      else
+        e.pairs.push_back(remeasured(p, problem_.shapes, std::span<const Pose>(e.poses), problem_.box));
       e.distances(static_cast<Eigen::Index>(k)) = e.pairs.back().points.distance;
     }
     return e;
@@ -436,6 +496,9 @@ class ContactStep {
   }
   int dofs_per_body() const { return dofs_; }
   const Eigen::SparseMatrix<double>& D() const { return D_; }
+  // M D, exact and sparse, in blocks mode; nullptr in the other modes.
+  const Eigen::SparseMatrix<double>* sparse_MD() const { return cost_ == MobilityCost::blocks ? &MD_ : nullptr; }
+  MobilityCost cost() const { return cost_; }  // the mode in use (automatic resolved)
   const std::vector<ContactColumn>& columns() const { return columns_; }  // D's, one per pair
   const std::vector<ContactPair>& pairs() const { return pairs_; }
   const ContactStepProblem<S>& problem() const { return problem_; }
@@ -476,6 +539,11 @@ class ContactStep {
     }
     D_ = assemble_contact_matrix(columns, trial_.size(), dofs_);
     columns_ = std::move(columns);
+    if (M_blocks_.rows() > 0) MD_ = M_blocks_ * D_;  // blocks mode, once M is set (the constructor's end)
+    at_trial_.clear();
+    at_trial_.reserve(pairs_.size());
+    for (std::size_t k = 0; k < pairs_.size(); ++k)  // carried pairs are measured by their gap instead
+      at_trial_.push_back(carried_[k] ? pairs_[k] : remeasured(pairs_[k], problem_.shapes, trial, problem_.box));
   }
 
   // With overlap_ends directions, the pairs from `first` on that are not carried become
@@ -598,6 +666,9 @@ class ContactStep {
   Eigen::SparseMatrix<double> D_;
   std::vector<ContactColumn> columns_;  // D_'s columns
   std::vector<VecX> MD_columns_;  // the columns of M D formed so far (empty: not yet)
+  MobilityCost cost_ = MobilityCost::formed;
+  std::vector<ContactPair> at_trial_;  // per pair: remeasured at Q* (measure's unmoved pairs)
+  Eigen::SparseMatrix<double> M_blocks_, MD_;  // blocks mode: M at Q_t and M D
   std::optional<ContactEvaluation> last_;
 };
 
@@ -685,6 +756,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   r.lambda_sum = r.lambda.sum();
   r.lambda_max = r.lambda.size() == 0 ? 0.0 : r.lambda.maxCoeff();
   r.mobility_applications = step.applications();
+  r.cost = step.cost();
   if (!violating.empty() || !crossing.empty() || !beyond_box.empty()) {
     std::ostringstream os;
     os << "failed separation after " << r.guarantee_rounds << " guarantee round(s):";

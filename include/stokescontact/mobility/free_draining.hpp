@@ -30,6 +30,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/SparseCore>
 
 #include "stokescontact/core/errors.hpp"
 #include "stokescontact/core/pose.hpp"
@@ -178,6 +179,22 @@ class FreeDrainingMobility {
     MatX m = MatX::Zero(size(), size());
     for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(shape_of_body_.size()); ++i)
       m.block(dofs_ * i, dofs_ * i, dofs_, dofs_) = block(i).topLeftCorner(dofs_, dofs_);
+    return m;
+  }
+
+  // The same matrix, sparse: dofs^2 entries per body (BlockDiagonalMobility, 0 applications).
+  Eigen::SparseMatrix<double> block_diagonal() const {
+    require_configured();
+    const auto n = static_cast<Eigen::Index>(shape_of_body_.size());
+    Eigen::SparseMatrix<double> m(size(), size());
+    m.reserve(Eigen::VectorXi::Constant(size(), dofs_));
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Mat6 b = block(i);
+      for (int c = 0; c < dofs_; ++c)
+        for (int r = 0; r < dofs_; ++r)
+          if (b(r, c) != 0.0) m.insert(dofs_ * i + r, dofs_ * i + c) = b(r, c);
+    }
+    m.makeCompressed();
     return m;
   }
 

@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <span>
 
+#include <Eigen/SparseCore>
+
 #include "stokescontact/core/pose.hpp"
 #include "stokescontact/core/types.hpp"
 
@@ -32,6 +34,15 @@ concept MobilityOperator = requires(M& m, const M& cm, std::span<const Pose> pos
 template <typename M>
 concept DenseMobilityOperator = MobilityOperator<M> && requires(M& m) {
   { m.dense_matrix() } -> std::convertible_to<MatX>;
+};
+
+// A model whose M is block diagonal (bodies do not interact through the fluid: free
+// draining) and gives it as a sparse matrix, formed directly from its per-body blocks at the
+// current configuration (0 applications). The contact step then forms M D exactly and
+// sparsely, in O(bodies + contacts) (MobilityCost::blocks, contact/contact_step.hpp).
+template <typename M>
+concept BlockDiagonalMobility = MobilityOperator<M> && requires(const M& cm) {
+  { cm.block_diagonal() } -> std::convertible_to<Eigen::SparseMatrix<double>>;
 };
 
 // Brownian dynamics (Yan et al. eq. 29 with U_known the Brownian velocity, Sec. IV; Delong,

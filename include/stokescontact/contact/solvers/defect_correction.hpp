@@ -53,7 +53,8 @@
 //
 // Cost: the probes (one per colour of each batch of new working-set pairs) plus one
 // application per iteration; 0 when no pair comes below d_hat. In formed mode every probe is
-// one exact column of M D (cached by the step), A~ = A, and the iterations are free.
+// one exact column of M D (cached by the step), A~ = A, and the iterations are free; in
+// blocks mode (free draining) A~ = A is read from the sparse M D and nothing costs an application.
 // Nothing is dense in the working set: A~ is sparse (delassus_probing.hpp), its LCP is solved
 // with products only (GMRES inside minimum-map Newton), the secant correction is a low-rank
 // operator (secant_update.hpp), and the lift to positive definite is a diagonal shift beyond
@@ -61,6 +62,7 @@
 // step of 1e6 free-draining spheres with 9e4 pushed pairs ran in 1.1 GB (docs/results.md).
 // Iterations reported: corrections (LCPs solved).
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <span>
@@ -251,7 +253,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
   const double ray_tol = 1e-9;  // relative width of a crossing's bracket: the samples are cheap
   int stalled = 0;
   const double d_hat = step.problem().d_hat, target = d_hat * (1.0 + options.margin);
-  const double radius = step.options().cost == MobilityCost::formed
+  const double radius = step.cost() != MobilityCost::matrix_free  // formed and blocks: exact
                             ? std::numeric_limits<double>::infinity()
                             : options.probe_radius_factor * largest_bounding_radius(step.problem().shapes);
   DelassusProbing probing(step, radius);
@@ -293,7 +295,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       best_MD = e.MD_lambda;
     }
     // (With every probe a single contact the model is exact, and slowness is the geometry's.)
-    const bool shared_probes = probing.probes() < static_cast<int>(probing.members().size());
+    const bool shared_probes = std::isfinite(radius) && probing.probes() < static_cast<int>(probing.members().size());
     slow_corrections = shared_probes && shortfall > options.contraction * previous_shortfall ? slow_corrections + 1 : 0;
     if (slow_corrections == 2) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options);
     // Corrections that stall with exact single-contact probes: the linear model points the
@@ -343,10 +345,12 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
     const double scale = std::max(next.lpNorm<Eigen::Infinity>(), lambda.lpNorm<Eigen::Infinity>());
     if (e.min_distance() >= d_hat && change <= options.tol * scale) {  // Broms eq. 29 at a separated iterate
       // A smaller separating force on the same ray (a far root of a non-monotone d): the
-      // samples before s = 1 only, so a monotone d costs them and nothing else.
+      // samples before s = 1 only (s = j / ray_samples, j < ray_samples), so a monotone d
+      // costs them and nothing else (no bisection towards s = 1, whose crossing is lambda's).
       if (search_rays && lambda.sum() > 0.0) {
-        const std::optional<double> s =
-            ray_first_crossing(step, e.MD_lambda, 1.0, target, options.ray_samples, ray_tol);
+        const int below_one = options.ray_samples - 1;
+        const std::optional<double> s = ray_first_crossing(step, e.MD_lambda, double(below_one) / options.ray_samples,
+                                                           target, below_one, ray_tol);
         if (s && *s < 1.0 - 1.0 / options.ray_samples)
           return restart_from_crossing(step, lambda, *s, out.iterations, options, "converged to a far root");
       }

@@ -10,7 +10,9 @@
 // to the member nearest k when that member lies within radius / 2 (at most one can), and is
 // taken as 0 otherwise. The entries lost are the far field between contacts >= radius / 2
 // apart; the contact solver (defect_correction.hpp) corrects for them with exact velocities.
-// With radius = infinity every probe has one member and A is exact (formed mode).
+// With radius = infinity every probe has one member and A is exact (formed mode). In blocks
+// mode (a block-diagonal model, ContactStep::sparse_MD) there are no probes: the columns of A
+// are read exactly from M D, dt D^T (M D) e_c, at no application.
 //
 // Everything is sparse, so a working set of 1e5 contacts costs O(its size) in time and memory:
 // the rows read (R, flagged pairs x working set) are kept only within radius / 2 of their
@@ -87,6 +89,11 @@ class DelassusProbing {
     if (contacts.empty()) return;
     const auto first_new = static_cast<Eigen::Index>(members_.size());
     members_.insert(members_.end(), contacts.begin(), contacts.end());
+    if (const SparseMatrix* MD = step.sparse_MD()) {
+      read_exact_columns(step.problem().dt, step.D(), *MD, first_new);
+      assemble();
+      return;
+    }
     const std::vector<std::vector<Eigen::Index>> colours = colour(first_new);
     for (const std::vector<Eigen::Index>& members : colours) {
       VecX indicator = VecX::Zero(step.nc());
@@ -99,6 +106,21 @@ class DelassusProbing {
   }
 
  private:
+  // The columns of A = dt D^T (M D) for the members from first_new on, exact (blocks mode).
+  void read_exact_columns(double dt, const SparseMatrix& D, const SparseMatrix& MD, Eigen::Index first_new) {
+    const auto count = static_cast<Eigen::Index>(members_.size()) - first_new;
+    std::vector<Eigen::Triplet<double>> select;
+    for (Eigen::Index m = 0; m < count; ++m)
+      select.emplace_back(static_cast<int>(members_[static_cast<std::size_t>(first_new + m)]), static_cast<int>(m), 1.0);
+    SparseMatrix selector(nc_, count);
+    selector.setFromTriplets(select.begin(), select.end());
+    const SparseMatrix MD_new = MD * selector;
+    const SparseMatrix columns = dt * SparseMatrix(D.transpose() * MD_new);
+    for (Eigen::Index m = 0; m < count; ++m)
+      for (SparseMatrix::InnerIterator it(columns, m); it; ++it)
+        if (it.value() != 0.0) read_triplets_.emplace_back(static_cast<int>(it.row()), static_cast<int>(first_new + m), it.value());
+  }
+
   // Between flagged pairs k and l.
   double contact_distance(Eigen::Index k, Eigen::Index l) const {
     Vec3 r = positions_.col(l) - positions_.col(k);

@@ -1,0 +1,58 @@
+// One contact step of the default solver (detection, solve, whole-step guarantee) for N unit
+// spheres at packing 0.3 (random sequential addition, seed N), random forces |f| = 100, free
+// draining, dt = d_hat = 0.01: the scene of examples/contact_step_scaling, per cost mode
+// (contact_step.hpp). The scene and U are built once; each iteration is one contact step from
+// the same Q_t. Counters: flagged and pushed pairs, mobility applications, time per sphere.
+// N = 1e6 is registered but takes seconds per iteration: select it with --benchmark_filter.
+#include <benchmark/benchmark.h>
+
+#include <cstddef>
+#include <vector>
+
+#include "stokescontact/contact/solvers/contact_solver.hpp"
+#include "stokescontact/mobility/free_draining.hpp"
+#include "stokescontact/scenes/random.hpp"
+#include "stokescontact/scenes/sphere_packing.hpp"
+
+namespace {
+
+using namespace stokescontact;
+
+void run(benchmark::State& state, MobilityCost cost) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const double dt = 0.01, d_hat = 0.01;
+  const std::vector<Sphere> shapes{Sphere{1.0}};
+  const SpherePacking packing = random_sequential_addition(n, 0.3, n);
+  Rng rng(n);
+  const std::vector<Vec3> f = random_forces(n, 100.0, rng);
+  VecX F(3 * static_cast<Eigen::Index>(n));
+  for (std::size_t k = 0; k < n; ++k) F.segment<3>(3 * static_cast<Eigen::Index>(k)) = f[k];
+  FreeDrainingMobility mobility(sphere_mobility(shapes[0], 1.0), n, 3);
+  mobility.set_configuration(packing.poses);
+  const VecX U = mobility.apply(F);
+  const ContactStepProblem<Sphere> problem{shapes, packing.poses, U, dt, d_hat};
+  ContactStepOptions options;
+  options.cost = cost;
+  ContactStepResult r;
+  for (auto _ : state) {
+    r = solve_contact_step(problem, mobility, options);
+    benchmark::DoNotOptimize(r.lambda.data());
+  }
+  if (r.status != ContactStepStatus::converged) state.SkipWithError(r.message.c_str());
+  state.counters["flagged"] = static_cast<double>(r.flagged_pairs);
+  state.counters["pushed"] = static_cast<double>((r.lambda.array() > 0.0).count());
+  state.counters["applications"] = static_cast<double>(r.mobility_applications);
+  state.counters["time_per_sphere"] = benchmark::Counter(
+      static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+void BM_ContactStepBlocks(benchmark::State& state) { run(state, MobilityCost::blocks); }
+void BM_ContactStepMatrixFree(benchmark::State& state) { run(state, MobilityCost::matrix_free); }
+void BM_ContactStepFormed(benchmark::State& state) { run(state, MobilityCost::formed); }
+
+BENCHMARK(BM_ContactStepBlocks)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ContactStepMatrixFree)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
+// Formed holds one dense column of M D per working-set pair: O(N x pairs), 1e4 at most here.
+BENCHMARK(BM_ContactStepFormed)->RangeMultiplier(10)->Range(1000, 10000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
