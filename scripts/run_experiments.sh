@@ -28,12 +28,14 @@ for part in "${parts[@]}"; do
   case $part in
     fig4)
       run fig4_rpy_default $bin/fig4_spheres --mobility rpy --pairs
-      run fig4_rpy_barrier_slsqp $bin/fig4_spheres --mobility rpy --solver barrier-slsqp --configs 50 --pairs ;;
+      run fig4_rpy_barrier_slsqp $bin/fig4_spheres --mobility rpy --solver barrier-slsqp --configs 50 --pairs
+      run fig4_rpy_barrier_working_set $bin/fig4_spheres --mobility rpy --solver barrier-working-set ;;
     fig4-multiblob)  # the paper's mobility: ~20 s per configuration on one core
       run fig4_multiblob_default $bin/fig4_spheres --mobility multiblob --configs 10 ;;
     table1)
       run table1_rpy_default $bin/fig4_spheres --table1 --mobility rpy --solver default
-      run table1_rpy_barrier_slsqp $bin/fig4_spheres --table1 --mobility rpy --solver barrier-slsqp --configs 10 ;;
+      run table1_rpy_barrier_slsqp $bin/fig4_spheres --table1 --mobility rpy --solver barrier-slsqp --configs 10
+      run table1_rpy_barrier_working_set $bin/fig4_spheres --table1 --mobility rpy --solver barrier-working-set ;;
     fig9)  # 40 boomerangs, 200 configurations per run: about a minute in all
       for solver in default lcp-newton barrier-slsqp; do
         for mobility in free-draining multiblob; do

@@ -46,7 +46,7 @@ TEST(ContactSolver, NamesRoundTripAndTheDefaultComesFirst) {
   const std::vector<std::string> names = sc::contact_solver_names();
   ASSERT_FALSE(names.empty());
   EXPECT_EQ(names.front(), "default");
-  EXPECT_EQ(names.size(), 7u);  // this build has NLopt: three barrier variants
+  EXPECT_EQ(names.size(), 10u);  // this build has NLopt: six barrier variants
   for (const std::string& name : names) EXPECT_EQ(sc::contact_solver_name(sc::contact_solver_from_name(name)), name);
   EXPECT_TRUE(std::holds_alternative<sc::DefectCorrectionOptions>(sc::ContactSolver{}));
   EXPECT_EQ(std::get<sc::LcpSequenceOptions>(sc::contact_solver_from_name("lcp-apgd")).inner, sc::InnerLcpSolver::apgd);
@@ -81,6 +81,7 @@ TEST(ContactSolver, SolveContactStepRunsTheChosenSolver) {
   const Row row;
   for (const std::string& name : sc::contact_solver_names()) {
     if (name == "barrier-cobyla") continue;  // derivative free: correct but slow, covered elsewhere
+    // (barrier-working-set-cobyla: COBYLA on the 2-pair model problems, no application)
     SCOPED_TRACE(name);
     const sc::ContactSolver solver = sc::contact_solver_from_name(name);
     auto m1 = row.mobility();
@@ -128,3 +129,36 @@ TEST(ContactSolver, DeprecatedNamesStillWork) {
 }
 
 }  // namespace
+
+// Broms eq. 15 on a working-set model (barrier_working_set.hpp) against its exact solution.
+// A = [1 .6 0; .6 1 .6; 0 .6 1] (positive definite, not a Z-matrix: pushing the middle pair
+// opens the outer ones), d = 0, target 1. Complementarity (the default solver's LCP) gives
+// (1, 0, 1), sum 2, dissipation y^T A y = 2; the smallest sum with A y >= 1 is the vertex
+// (0, 5/3, 0), sum 5/3, dissipation 25/9; the smallest dissipation is (1, 0, 1) again (KKT:
+// 2 A y = A mu, mu = 2 y complementary to A y - 1 >= 0, y >= 0).
+TEST(BarrierWorkingSet, ModelProblemIsTheSmallestSumOrDissipation) {
+  const sc::MatX A = (sc::MatX(3, 3) << 1.0, 0.6, 0.0, 0.6, 1.0, 0.6, 0.0, 0.6, 1.0).finished();
+  const std::vector<Eigen::Index> W{0, 1, 2};
+  const sc::VecX zero = sc::VecX::Zero(3);
+  const auto lcp = sc::detail::solve_working_set_lcp(A, W, zero, zero, 1.0, sc::LcpOptions{1e-12});
+  ASSERT_TRUE(lcp.has_value());
+  EXPECT_NEAR((*lcp - sc::Vec3(1.0, 0.0, 1.0)).norm(), 0.0, 1e-10);
+  for (const nlopt::algorithm algorithm : {nlopt::LD_SLSQP, nlopt::LD_MMA}) {
+    SCOPED_TRACE(algorithm == nlopt::LD_SLSQP ? "slsqp" : "mma");
+    sc::detail::WorkingSetBarrier sum{algorithm, false};
+    const auto y = sum(A, W, zero, zero, 1.0, 0);
+    ASSERT_TRUE(y.has_value());
+    EXPECT_NEAR((*y - sc::Vec3(0.0, 5.0 / 3.0, 0.0)).norm(), 0.0, 1e-6) << y->transpose();
+    const sc::VecX separation = A * *y;  // (a named product: GCC 12 misreads the temporary as used after free)
+    EXPECT_GE(separation.minCoeff(), 1.0 - 1e-6);
+    sc::detail::WorkingSetBarrier dissipation{algorithm, true};
+    const auto z = dissipation(A, W, zero, zero, 1.0, 0);
+    ASSERT_TRUE(z.has_value());
+    EXPECT_NEAR((*z - sc::Vec3(1.0, 0.0, 1.0)).norm(), 0.0, 1e-6) << z->transpose();
+  }
+  // Nothing below the target: no force, no NLopt call.
+  sc::detail::WorkingSetBarrier sum;
+  const auto none = sum(A, W, zero, sc::VecX::Constant(3, 2.0), 1.0, 0);
+  ASSERT_TRUE(none.has_value());
+  EXPECT_EQ(none->norm(), 0.0);
+}

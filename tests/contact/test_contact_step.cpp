@@ -31,15 +31,18 @@ using test_support::random_rotation;
 using test_support::random_unit_vector;
 
 // Every solver behind the one interface.
-enum class Solver { kDefault, kLcpBbpgd, kLcpApgd, kLcpNewton, kBarrierSlsqp, kBarrierCobyla, kBarrierMma };
+enum class Solver {
+  kDefault, kLcpBbpgd, kLcpApgd, kLcpNewton, kBarrierSlsqp, kBarrierCobyla, kBarrierMma, kBarrierWorkingSet
+};
 const std::vector<Solver> kAllSolvers = {Solver::kDefault,      Solver::kLcpBbpgd,      Solver::kLcpApgd,
                                          Solver::kLcpNewton,    Solver::kBarrierSlsqp,  Solver::kBarrierCobyla,
-                                         Solver::kBarrierMma};
+                                         Solver::kBarrierMma,   Solver::kBarrierWorkingSet};
 // COBYLA is derivative free: it does not separate scenes of Nc ~ 20 pairs within 1000
 // evaluations, so the scene tests leave it out.
 // The default solves eq. 27 to complementarity: the others are compared with it.
-const std::vector<Solver> kSceneSolvers = {Solver::kDefault, Solver::kLcpNewton,     Solver::kLcpBbpgd,
-                                           Solver::kLcpApgd, Solver::kBarrierSlsqp, Solver::kBarrierMma};
+const std::vector<Solver> kSceneSolvers = {Solver::kDefault,      Solver::kLcpNewton,  Solver::kLcpBbpgd,
+                                           Solver::kLcpApgd,     Solver::kBarrierSlsqp, Solver::kBarrierMma,
+                                           Solver::kBarrierWorkingSet};
 
 std::string solver_name(Solver s) {
   switch (s) {
@@ -50,11 +53,16 @@ std::string solver_name(Solver s) {
     case Solver::kBarrierSlsqp: return "barrier/slsqp";
     case Solver::kBarrierCobyla: return "barrier/cobyla";
     case Solver::kBarrierMma: return "barrier/mma";
+    case Solver::kBarrierWorkingSet: return "barrier/working-set";
   }
   return "?";
 }
 
-bool is_barrier(Solver s) { return s == Solver::kBarrierSlsqp || s == Solver::kBarrierCobyla || s == Solver::kBarrierMma; }
+// The paper's barrier form (a scalar energy constraint): stops by eq. 29 inside the margin.
+bool is_energy_barrier(Solver s) { return s == Solver::kBarrierSlsqp || s == Solver::kBarrierCobyla || s == Solver::kBarrierMma; }
+// Defect correction (the default, and eq. 15 on its working set): aims at d_hat (1 + 1e-4),
+// returns a measured separated iterate, eq. 29 with tol 1e-4.
+bool holds_margin(Solver s) { return s == Solver::kDefault || s == Solver::kBarrierWorkingSet; }
 
 // The default solver aims at d_hat (1 + margin) and stops by eq. 29 with its tol: its lambda
 // exceeds the exact one by about margin d_hat / (the overlap removed), plus tol.
@@ -73,8 +81,12 @@ sc::ContactStepResult run(Solver s, const sc::ContactStepProblem<S>& p, M& mobil
     case Solver::kBarrierSlsqp: bar.optimizer = sc::BarrierOptimizer::slsqp; break;
     case Solver::kBarrierCobyla: bar.optimizer = sc::BarrierOptimizer::cobyla; break;
     case Solver::kBarrierMma: bar.optimizer = sc::BarrierOptimizer::mma; break;
+    case Solver::kBarrierWorkingSet:
+      bar.constraint = sc::BarrierConstraint::working_set;
+      bar.tol = 1e-4;  // as the default solver's ("barrier-working-set")
+      return sc::solve_contact_step_barrier(p, mobility, options, bar);
   }
-  if (is_barrier(s)) return sc::solve_contact_step_barrier(p, mobility, options, bar);
+  if (is_energy_barrier(s)) return sc::solve_contact_step_barrier(p, mobility, options, bar);
   return sc::solve_contact_step_lcp_sequence(p, mobility, options, seq);
 }
 
@@ -159,11 +171,11 @@ TEST(ContactStep, TwoSpheresHeadOnMatchClosedFormForEverySolver) {
       EXPECT_EQ(r.flagged_pairs, 1u);
       // The LCP sequence is exact (one LCP); the barrier stops within the separation margin;
       // the default aims at d_hat (1 + 1e-4): lambda* (1 + 1e-4 d_hat / (d_hat - d*)).
-      if (solver == Solver::kDefault) {
+      if (holds_margin(solver)) {
         EXPECT_NEAR(r.lambda(0), lambda_star * (1.0 + 1e-4 * s.d_hat / (s.d_hat - d_star)), 1e-8 * lambda_star);
         EXPECT_GE(r.min_distance_ratio, 1.0);
       }
-      EXPECT_NEAR(r.lambda(0), lambda_star, (is_barrier(solver) ? 2e-3 : solver == Solver::kDefault ? 1e-5 : 1e-8) * lambda_star);
+      EXPECT_NEAR(r.lambda(0), lambda_star, (is_energy_barrier(solver) ? 2e-3 : holds_margin(solver) ? 1e-5 : 1e-8) * lambda_star);
       EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
       EXPECT_NEAR(r.velocities(0), 10.0 - kMu * r.lambda(0), 1e-12 * lambda_star);
       EXPECT_DOUBLE_EQ(r.barrier_energy, r.barrier_energy);  // finite
@@ -211,12 +223,12 @@ TEST(ContactStep, PairsThatStayApartGetNoForce) {
     ASSERT_EQ(r.flagged_pairs, 2u);
     for (std::size_t k = 0; k < r.pairs.size(); ++k) {
       if (r.pairs[k].j == 2) {
-        EXPECT_LE(r.lambda(static_cast<Eigen::Index>(k)), (is_barrier(solver) ? 1e-2 : 1e-10) * r.lambda_max);
+        EXPECT_LE(r.lambda(static_cast<Eigen::Index>(k)), (is_energy_barrier(solver) ? 1e-2 : 1e-10) * r.lambda_max);
       }
     }
     // The barrier stops by eq. 29 (TOL = 1e-2), not at exact complementarity; the default
     // holds pushed pairs at d_hat (1 + 1e-4).
-    EXPECT_LE(r.complementarity_residual, is_barrier(solver) ? 5e-2 : solver == Solver::kDefault ? 2e-4 : 1e-6);
+    EXPECT_LE(r.complementarity_residual, is_energy_barrier(solver) ? 5e-2 : holds_margin(solver) ? 2e-4 : 1e-6);
     expect_third_law(r, 3);
   }
 }
@@ -237,11 +249,14 @@ TEST(ContactStep, SolversAgreeOnRandomSphereScenes) {
     for (std::size_t k = 0; k < results.size(); ++k) {
       SCOPED_TRACE(solver_name(kSceneSolvers[k]) + " seed " + std::to_string(seed));
       const sc::ContactStepResult& r = results[k];
-      const bool lcp_sequence = kSceneSolvers[k] != Solver::kDefault && !is_barrier(kSceneSolvers[k]);
+      const bool lcp_sequence = !holds_margin(kSceneSolvers[k]) && !is_energy_barrier(kSceneSolvers[k]);
       EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
-      EXPECT_GE(r.min_distance_ratio, kSceneSolvers[k] == Solver::kDefault ? 1.0 - 1e-9 : 1.0 - 1e-3);
+      EXPECT_GE(r.min_distance_ratio, holds_margin(kSceneSolvers[k]) ? 1.0 - 1e-9 : 1.0 - 1e-3);
       EXPECT_NEAR(r.lambda_sum, reference, (lcp_sequence ? 3e-2 : 2e-2) * reference);
-      if (kSceneSolvers[k] == Solver::kDefault) {  // margin 1e-4, stopped by eq. 29 with tol 1e-4
+      if (kSceneSolvers[k] == Solver::kBarrierWorkingSet) {  // eq. 15: no more force than complementarity
+        EXPECT_LE(r.lambda_sum, reference * (1.0 + kDefaultLambdaTolerance));
+      }
+      if (holds_margin(kSceneSolvers[k])) {  // margin 1e-4, stopped by eq. 29 with tol 1e-4
         EXPECT_LE(r.complementarity_residual, 1e-3);
       }
       expect_third_law(r, 3);
@@ -252,12 +267,15 @@ TEST(ContactStep, SolversAgreeOnRandomSphereScenes) {
 // Sec. 3.1.2: each objective's solution is the better one in its own measure (up to the eq. 29
 // stopping rule): the dissipation objective dissipates no more, the 1-norm one pushes no more.
 TEST(ContactStep, EachBarrierObjectiveWinsInItsOwnMeasure) {
+  for (const sc::BarrierConstraint constraint : {sc::BarrierConstraint::energy, sc::BarrierConstraint::working_set})
   for (const std::uint64_t seed : {11u, 12u}) {
+    SCOPED_TRACE(constraint == sc::BarrierConstraint::energy ? "energy" : "working set");
     const SphereScene s = random_spheres(seed, 30, 8.0, 10.0);
     const auto solve = [&](sc::BarrierObjective objective) {
       auto m = s.mobility();
       sc::BarrierNloptOptions bar;
       bar.objective = objective;
+      bar.constraint = constraint;
       bar.tol = 1e-4;
       return sc::solve_contact_step_barrier(s.problem(), m, {}, bar);
     };
@@ -308,7 +326,7 @@ TEST(ContactStep, SolversAgreeOnRodScenes) {
     for (std::size_t k = 0; k < results.size(); ++k) {
       SCOPED_TRACE(solver_name(kSceneSolvers[k]) + " seed " + std::to_string(seed));
       const sc::ContactStepResult& r = results[k];
-      const bool is_default = kSceneSolvers[k] == Solver::kDefault;
+      const bool is_default = holds_margin(kSceneSolvers[k]);
       EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
       EXPECT_GE(r.min_distance_ratio, is_default ? 1.0 - 1e-9 : 1.0 - 1e-3);
       EXPECT_NEAR(r.lambda_sum, reference, 1e-2 * reference);
@@ -332,7 +350,7 @@ TEST(ContactStep, SolversAgreeOnRodScenes) {
         const double exact_model = cost == sc::MobilityCost::formed ? 1e-6 : 0.0;  // formed and blocks: one model
         EXPECT_NEAR(other.lambda_sum, r.lambda_sum,
                     (exact_model > 0.0 ? exact_model
-                     : is_barrier(kSceneSolvers[k]) ? 1e-3
+                     : is_energy_barrier(kSceneSolvers[k]) ? 1e-3
                      : is_default                   ? kDefaultLambdaTolerance
                                                     : 1e-6) * r.lambda_sum);
       }
@@ -384,7 +402,8 @@ TEST(ContactStep, GuaranteeFailureIsReportedNotHidden) {
 TEST(ContactStep, DenseSceneWithSmallDTryIsSeparatedByTheGuaranteeLoop) {
   SphereScene s = random_spheres(32, 30, 8.0, 10.0);  // a scene whose trial step misses pairs
   s.d_try = s.d_hat;
-  for (const Solver solver : {Solver::kDefault, Solver::kLcpNewton, Solver::kBarrierSlsqp, Solver::kBarrierMma}) {
+  for (const Solver solver :
+       {Solver::kDefault, Solver::kLcpNewton, Solver::kBarrierSlsqp, Solver::kBarrierMma, Solver::kBarrierWorkingSet}) {
     SCOPED_TRACE(solver_name(solver));
     auto m = s.mobility();
     const sc::ContactStepResult r = run(solver, s.problem(), m);

@@ -105,6 +105,11 @@ TEST(ContactStepSurface, BoomerangsDefaultToSurfaceNodesAndSeparate) {
     const sc::ContactStepResult by_particle = sc::solve_contact_step_defect_correction(p, m1, particle);
     const sc::ContactStepResult lcp = sc::solve_contact_step_lcp_sequence(p, m2);
     const sc::ContactStepResult barrier = sc::solve_contact_step_barrier(p, m3);
+    sc::BarrierNloptOptions on_working_set;  // eq. 15 on the default solver's working set
+    on_working_set.constraint = sc::BarrierConstraint::working_set;
+    on_working_set.tol = sc::DefectCorrectionOptions{}.tol;
+    auto m4 = mobility();
+    const sc::ContactStepResult working_set = sc::solve_contact_step_barrier(p, m4, {}, on_working_set);
     // D acts at the trial step Q* (eq. 16): the torques balance about its centres.
     std::vector<sc::Pose> trial;
     for (std::size_t b = 0; b < s.poses.size(); ++b) {
@@ -112,7 +117,7 @@ TEST(ContactStepSurface, BoomerangsDefaultToSurfaceNodesAndSeparate) {
       trial.push_back(sc::advance(s.poses[b], s.U.segment<3>(row), s.U.segment<3>(row + 3), 0.01));
     }
     ASSERT_GT(by_default.lambda_max, 0.0) << "seed " << seed << ": no contact force, the test needs one";
-    for (const sc::ContactStepResult* r : {&by_default, &by_particle, &lcp, &barrier}) {
+    for (const sc::ContactStepResult* r : {&by_default, &by_particle, &lcp, &barrier, &working_set}) {
       std::printf("[boomerangs seed %d] status %d Nc %zu apps %zu iters %d sum %.6f min d/d_hat %.9f\n",
                   static_cast<int>(seed), static_cast<int>(r->status), r->flagged_pairs, r->mobility_applications,
                   r->iterations, r->lambda_sum, r->min_distance_ratio);
@@ -123,6 +128,10 @@ TEST(ContactStepSurface, BoomerangsDefaultToSurfaceNodesAndSeparate) {
     EXPECT_GE(by_default.min_distance_ratio, 1.0 - 1e-9);
     EXPECT_GT((by_default.contact_forces - by_particle.contact_forces).norm(), 1e-6 * by_default.lambda_sum);
     EXPECT_NEAR(lcp.lambda_sum, by_default.lambda_sum, 5e-2 * by_default.lambda_sum);
+    // Separated as the default is, with no more force than complementarity needs.
+    EXPECT_GE(working_set.min_distance_ratio, 1.0 - 1e-9);
+    EXPECT_LE(working_set.lambda_sum, by_default.lambda_sum * (1.0 + 2e-4));
+    EXPECT_NEAR(working_set.lambda_sum, by_default.lambda_sum, 1e-2 * by_default.lambda_sum);
   }
 }
 
@@ -188,8 +197,12 @@ TEST(ContactStepSurface, InterlockedBoomerangsGetTheSmallestSeparatingForce) {
       // of this pair come 9e-4 d_hat into each other (g = 0.05, d^P), which the whole-step
       // check reports as failed separation; the time stepper then sub-steps (below).
       options.whole_step = false;
-      sc::FreeDrainingMobility m1(body, 2, 6), m2(body, 2, 6);
+      sc::FreeDrainingMobility m1(body, 2, 6), m2(body, 2, 6), m3(body, 2, 6);
       const sc::ContactStepResult r = sc::solve_contact_step_defect_correction(p, m1, options);
+      sc::BarrierNloptOptions on_working_set;  // eq. 15 on the working set: the same ray search
+      on_working_set.constraint = sc::BarrierConstraint::working_set;
+      on_working_set.tol = sc::DefectCorrectionOptions{}.tol;
+      const sc::ContactStepResult barrier = sc::solve_contact_step_barrier(p, m3, options, on_working_set);
       std::printf("[interlocked g %.2f %s] status %s lambda %.4f apps %zu iters %d min d/d_hat %.6f %s\n", g,
                   directions == sc::ContactDirections::particle ? "d^P" : "d^S",
                   std::string(sc::to_string(r.status)).c_str(), r.lambda_sum, r.mobility_applications, r.iterations,
@@ -200,6 +213,10 @@ TEST(ContactStepSurface, InterlockedBoomerangsGetTheSmallestSeparatingForce) {
       sc::ContactStep<sc::Boomerang, sc::FreeDrainingMobility> step(p, m2, options);
       const double reference = first_separating_lambda(step, g, 0.5, 5000.0);
       EXPECT_NEAR(r.lambda(0), reference, 1e-3 * reference);
+      EXPECT_EQ(barrier.status, sc::ContactStepStatus::converged) << barrier.message;
+      EXPECT_GE(barrier.min_distance_ratio, 1.0);
+      ASSERT_EQ(barrier.lambda.size(), 1);
+      EXPECT_NEAR(barrier.lambda(0), reference, 1e-3 * reference) << barrier.message;
     }
   }
 }

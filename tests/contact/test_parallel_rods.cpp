@@ -90,7 +90,12 @@ struct SolverRun {
 
 std::vector<SolverRun> runs() {
   return {{"default", sc::DefectCorrectionOptions{}, kDHat * (1.0 + sc::DefectCorrectionOptions{}.margin)},
-          {"lcp-newton", sc::LcpSequenceOptions{}, kDHat}};
+          {"lcp-newton", sc::LcpSequenceOptions{}, kDHat},
+#if STOKESCONTACT_HAS_NLOPT  // eq. 15 on the default solver's working set: its target and corrections
+          {"barrier-working-set", sc::contact_solver_from_name("barrier-working-set"),
+           kDHat * (1.0 + sc::DefectCorrectionOptions{}.margin)},
+#endif
+  };
 }
 
 void check_stack(const sc::ContactStepResult& r, const std::vector<sc::Pose>& before) {

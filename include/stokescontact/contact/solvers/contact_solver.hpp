@@ -10,7 +10,9 @@
 //                             (STOKESCONTACT_HAS_NLOPT)
 // Every solver returns the same ContactStepResult. Drivers and scene files name a solver by a
 // string (contact_solver_from_name): "default", "lcp-bbpgd", "lcp-apgd", "lcp-newton",
-// "barrier-slsqp", "barrier-mma", "barrier-cobyla".
+// "barrier-slsqp", "barrier-mma", "barrier-cobyla" (the paper's scalar constraint), and
+// "barrier-working-set" (SLSQP), "barrier-working-set-mma" and "barrier-working-set-cobyla"
+// (eq. 15 pair by pair on the working-set model, TOL 1e-4 as the default solver's).
 #include <array>
 #include <optional>
 #include <string>
@@ -55,6 +57,15 @@ ContactSolver barrier_with() {
   o.optimizer = Optimizer;
   return o;
 }
+
+template <BarrierOptimizer Optimizer>
+ContactSolver barrier_working_set_with() {
+  BarrierNloptOptions o;
+  o.optimizer = Optimizer;
+  o.constraint = BarrierConstraint::working_set;
+  o.tol = DefectCorrectionOptions{}.tol;
+  return o;
+}
 #endif
 
 inline constexpr std::array kNamedContactSolvers{
@@ -66,6 +77,9 @@ inline constexpr std::array kNamedContactSolvers{
     NamedContactSolver{"barrier-slsqp", &barrier_with<BarrierOptimizer::slsqp>},
     NamedContactSolver{"barrier-mma", &barrier_with<BarrierOptimizer::mma>},
     NamedContactSolver{"barrier-cobyla", &barrier_with<BarrierOptimizer::cobyla>},
+    NamedContactSolver{"barrier-working-set", &barrier_working_set_with<BarrierOptimizer::slsqp>},
+    NamedContactSolver{"barrier-working-set-mma", &barrier_working_set_with<BarrierOptimizer::mma>},
+    NamedContactSolver{"barrier-working-set-cobyla", &barrier_working_set_with<BarrierOptimizer::cobyla>},
 #endif
 };
 
@@ -109,6 +123,11 @@ inline std::string contact_solver_name(const ContactSolver& solver) {
         }
 #if STOKESCONTACT_HAS_NLOPT
         else {
+          if (o.constraint == BarrierConstraint::working_set) switch (o.optimizer) {
+              case BarrierOptimizer::slsqp: return "barrier-working-set";
+              case BarrierOptimizer::mma: return "barrier-working-set-mma";
+              case BarrierOptimizer::cobyla: return "barrier-working-set-cobyla";
+            }
           switch (o.optimizer) {
             case BarrierOptimizer::slsqp: return "barrier-slsqp";
             case BarrierOptimizer::mma: return "barrier-mma";

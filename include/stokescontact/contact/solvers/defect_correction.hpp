@@ -4,11 +4,12 @@
 // solved by defect correction with a probed Delassus matrix: no pair below d_hat, and a force
 // only on pairs held at the threshold. That is a feasible point of the barrier method's
 // problem (Broms eq. 15, the smallest sum of lambda with every pair at d >= d_hat), and its
-// minimum where pushing one pair never brings another closer (for the linearised problem: A a
-// Z-matrix, whose LCP solution is the least element of the feasible set; Cottle, Pang & Stone,
-// The Linear Complementarity Problem, Sec. 3.11). Where a push on one pair does close another
-// (large steps, dense clusters), the smallest sum can be lower: it pushes some pairs that then
-// end apart, a force on a pair that is not touching, which complementarity forbids.
+// minimum where pushing one pair never moves another apart (for the linearised problem: A a
+// Z-matrix, off-diagonal entries <= 0, whose LCP solution is the least element of the feasible
+// set; Cottle, Pang & Stone, The Linear Complementarity Problem, Sec. 3.11). Where a push on one
+// pair does open another (pairs meeting at a sharp angle on a shared body, turning rods), the
+// smallest sum can be lower: it pushes some pairs that then end apart, a force on a pair that is
+// not touching, which complementarity forbids (barrier_working_set.hpp solves that problem).
 //
 // Why it is cheap. Of the Nc pairs flagged by d_try, only the few that the trial step brings
 // below d_hat need a force (in the Broms Fig. 4 scenes ~4% of them), and those are spread through the
@@ -67,6 +68,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -173,6 +175,21 @@ std::optional<VecX> solve_working_set_lcp(const Model& A, std::span<const Eigen:
   return next;
 }
 
+// The problem each correction solves on the working set's linear model, as the default solver
+// poses it: the LCP above (Broms eq. 27, complementarity). The round takes any callable of
+// this shape, which is also told the correction's number in the round (barrier_working_set.hpp
+// poses eq. 15 instead); `name` prefixes its messages.
+struct WorkingSetLcp {
+  LcpOptions options;
+  std::string_view name = "default solver";
+
+  template <LcpMatrixOperator Model>
+  std::optional<VecX> operator()(const Model& A, std::span<const Eigen::Index> W, const VecX& lambda,
+                                 const VecX& distances, double target, int /*correction*/) const {
+    return solve_working_set_lcp(A, W, lambda, distances, target, options);
+  }
+};
+
 // The smallest distance of the flagged pairs at Q(lambda) = Q_t + dt Psi (U + M D lambda)
 // (Broms eq. 13), given M D lambda: no mobility application.
 template <Shape S, MobilityOperator M>
@@ -209,30 +226,32 @@ std::optional<double> ray_first_crossing(const ContactStep<S, M>& step, const Ve
 // The fallback of a round whose corrections do not contract.
 template <Shape S, MobilityOperator M>
 ContactSolveOutcome finish_by_lcp_sequence(ContactStep<S, M>& step, const VecX& lambda, int corrections,
-                                           const DefectCorrectionOptions& options) {
+                                           const DefectCorrectionOptions& options, std::string_view name) {
   LcpSequenceOptions sequence;
   sequence.tol = options.tol;  // on to complementarity, as the corrections would have
   sequence.margin = options.margin;
   ContactSolveOutcome out = solve_lcp_sequence_round(step, lambda, sequence);
-  out.message = "default solver: probing did not contract after " + std::to_string(corrections) +
+  out.message = std::string(name) + ": probing did not contract after " + std::to_string(corrections) +
                 " corrections, finished by the LCP sequence (" + std::to_string(out.iterations) + " LCPs)" +
                 (out.message.empty() ? "" : ": " + out.message);
   out.iterations += corrections;
   return out;
 }
 
-template <Shape S, MobilityOperator M>
+template <Shape S, MobilityOperator M, class Subproblem>
 ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX lambda,
-                                                  const DefectCorrectionOptions& options, bool search_rays = true);
+                                                  const DefectCorrectionOptions& options, const Subproblem& subproblem,
+                                                  bool search_rays = true);
 
 // The round again from s lambda, the first crossing of the ray found by ray_first_crossing
 // (no further ray search): its result when it separates with no more total force, else s
 // lambda itself, which separates. `before`: the corrections spent so far.
-template <Shape S, MobilityOperator M>
+template <Shape S, MobilityOperator M, class Subproblem>
 ContactSolveOutcome restart_from_crossing(ContactStep<S, M>& step, const VecX& lambda, double s, int before,
-                                          const DefectCorrectionOptions& options, const std::string& why) {
+                                          const DefectCorrectionOptions& options, const Subproblem& subproblem,
+                                          const std::string& why) {
   const VecX start = s * lambda;
-  ContactSolveOutcome out = solve_defect_correction_round(step, start, options, false);
+  ContactSolveOutcome out = solve_defect_correction_round(step, start, options, subproblem, false);
   const bool kept = out.converged && step.evaluate(out.lambda).min_distance() >= step.problem().d_hat &&
                     out.lambda.sum() <= start.sum();
   if (!kept) {
@@ -240,15 +259,17 @@ ContactSolveOutcome restart_from_crossing(ContactStep<S, M>& step, const VecX& l
     out.converged = true;  // separated (the crossing), no force beyond the ray's smallest
   }
   out.iterations += before;
-  out.message = "default solver: " + why + ", first crossing of d_hat at " + std::to_string(s) + " x lambda" +
+  out.message = std::string(subproblem.name) + ": " + why + ", first crossing of d_hat at " + std::to_string(s) + " x lambda" +
                 (kept ? ", polished" : "");
   return out;
 }
 
-// One round from the warm start (the previous round's lambda, zero-padded).
-template <Shape S, MobilityOperator M>
+// One round from the warm start (the previous round's lambda, zero-padded); `subproblem`
+// solves each correction's problem on the working set (WorkingSetLcp for the default solver).
+template <Shape S, MobilityOperator M, class Subproblem>
 ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX lambda,
-                                                  const DefectCorrectionOptions& options, bool search_rays) {
+                                                  const DefectCorrectionOptions& options, const Subproblem& subproblem,
+                                                  bool search_rays) {
   ContactSolveOutcome out;
   const double ray_tol = 1e-9;  // relative width of a crossing's bracket: the samples are cheap
   int stalled = 0;
@@ -297,7 +318,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
     // (With every probe a single contact the model is exact, and slowness is the geometry's.)
     const bool shared_probes = std::isfinite(radius) && probing.probes() < static_cast<int>(probing.members().size());
     slow_corrections = shared_probes && shortfall > options.contraction * previous_shortfall ? slow_corrections + 1 : 0;
-    if (slow_corrections == 2) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options);
+    if (slow_corrections == 2) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options, subproblem.name);
     // Corrections that stall with exact single-contact probes: the linear model points the
     // wrong way (d falls along the force before it rises, non-convex contacts). The best ray is
     // doubled until it separates (free, see above), then searched back for its first crossing.
@@ -309,7 +330,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
         if (min_flagged_distance_at(step, s_max * MD_best) >= target) {
           if (const std::optional<double> s =
                   ray_first_crossing(step, MD_best, s_max, target, 2 * options.ray_samples, ray_tol))
-            return restart_from_crossing(step, best_lambda, *s, out.iterations, options,
+            return restart_from_crossing(step, best_lambda, *s, out.iterations, options, subproblem,
                                          "corrections stalled " + std::to_string(stalled) + " times");
           break;
         }
@@ -322,11 +343,11 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       // The secant-corrected model is not symmetric; should its LCP fail, the probed one (made
       // positive definite) is a strictly convex QP.
       if (probed.rows() != static_cast<Eigen::Index>(W.size())) probed = positive_definite(probing.matrix());
-      std::optional<VecX> solved =
-          solve_working_set_lcp(secant.corrected(probed, W), W, lambda, e.distances, target, options.lcp);
-      if (!solved) solved = solve_working_set_lcp(probed, W, lambda, e.distances, target, options.lcp);
+      std::optional<VecX> solved = subproblem(secant.corrected(probed, W), W, lambda, e.distances, target, out.iterations);
+      if (!solved) solved = subproblem(probed, W, lambda, e.distances, target, out.iterations);
       if (!solved) {
-        out.message = "default solver: the working-set LCP (" + std::to_string(W.size()) + " pairs) did not converge";
+        out.message = std::string(subproblem.name) + ": the working-set problem (" + std::to_string(W.size()) +
+                      " pairs) was not solved";
         out.lambda = std::move(lambda);
         return out;
       }
@@ -352,7 +373,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
         const std::optional<double> s = ray_first_crossing(step, e.MD_lambda, double(below_one) / options.ray_samples,
                                                            target, below_one, ray_tol);
         if (s && *s < 1.0 - 1.0 / options.ray_samples)
-          return restart_from_crossing(step, lambda, *s, out.iterations, options, "converged to a far root");
+          return restart_from_crossing(step, lambda, *s, out.iterations, options, subproblem, "converged to a far root");
       }
       out.converged = true;
       break;
@@ -360,8 +381,8 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
     if (out.iterations == options.max_iterations) {
       // Shared probes whose corrections contract, but too slowly to finish (a large cluster
       // whose shortfall halves every other correction): the exact products finish the round.
-      if (shared_probes) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options);
-      out.message = "default solver: " + std::to_string(out.iterations) + " corrections, min flagged d / d_hat = " +
+      if (shared_probes) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options, subproblem.name);
+      out.message = std::string(subproblem.name) + ": " + std::to_string(out.iterations) + " corrections, min flagged d / d_hat = " +
                     std::to_string(e.min_distance() / d_hat) + ", last change " + std::to_string(change / scale) +
                     " of ||lambda||_inf";
       break;
@@ -383,7 +404,7 @@ ContactStepResult solve_contact_step_defect_correction(const ContactStepProblem<
                                              const DefectCorrectionOptions& solver = {}) {
   solver.validate();
   return run_contact_step(problem, mobility, options, [&solver](ContactStep<S, M>& step, const VecX& warm) {
-    return detail::solve_defect_correction_round(step, warm, solver);
+    return detail::solve_defect_correction_round(step, warm, solver, detail::WorkingSetLcp{solver.lcp});
   });
 }
 
