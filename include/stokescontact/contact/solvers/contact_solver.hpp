@@ -11,8 +11,8 @@
 // Every solver returns the same ContactStepResult. Drivers and scene files name a solver by a
 // string (contact_solver_from_name): "default", "lcp-bbpgd", "lcp-apgd", "lcp-newton",
 // "barrier-slsqp", "barrier-mma", "barrier-cobyla" (the paper's scalar constraint), and
-// "barrier-working-set" (SLSQP), "barrier-working-set-mma" and "barrier-working-set-cobyla"
-// (eq. 15 pair by pair on the working-set model, TOL 1e-4 as the default solver's).
+// "barrier-working-set" (eq. 15 pair by pair on the working-set model with SLSQP, TOL 1e-4 as
+// the default solver's).
 #include <array>
 #include <optional>
 #include <string>
@@ -58,10 +58,8 @@ ContactSolver barrier_with() {
   return o;
 }
 
-template <BarrierOptimizer Optimizer>
-ContactSolver barrier_working_set_with() {
+inline ContactSolver barrier_working_set() {
   BarrierNloptOptions o;
-  o.optimizer = Optimizer;
   o.constraint = BarrierConstraint::working_set;
   o.tol = DefectCorrectionOptions{}.tol;
   return o;
@@ -77,9 +75,7 @@ inline constexpr std::array kNamedContactSolvers{
     NamedContactSolver{"barrier-slsqp", &barrier_with<BarrierOptimizer::slsqp>},
     NamedContactSolver{"barrier-mma", &barrier_with<BarrierOptimizer::mma>},
     NamedContactSolver{"barrier-cobyla", &barrier_with<BarrierOptimizer::cobyla>},
-    NamedContactSolver{"barrier-working-set", &barrier_working_set_with<BarrierOptimizer::slsqp>},
-    NamedContactSolver{"barrier-working-set-mma", &barrier_working_set_with<BarrierOptimizer::mma>},
-    NamedContactSolver{"barrier-working-set-cobyla", &barrier_working_set_with<BarrierOptimizer::cobyla>},
+    NamedContactSolver{"barrier-working-set", &barrier_working_set},
 #endif
 };
 
@@ -123,11 +119,7 @@ inline std::string contact_solver_name(const ContactSolver& solver) {
         }
 #if STOKESCONTACT_HAS_NLOPT
         else {
-          if (o.constraint == BarrierConstraint::working_set) switch (o.optimizer) {
-              case BarrierOptimizer::slsqp: return "barrier-working-set";
-              case BarrierOptimizer::mma: return "barrier-working-set-mma";
-              case BarrierOptimizer::cobyla: return "barrier-working-set-cobyla";
-            }
+          if (o.constraint == BarrierConstraint::working_set) return "barrier-working-set";  // SLSQP (validate)
           switch (o.optimizer) {
             case BarrierOptimizer::slsqp: return "barrier-slsqp";
             case BarrierOptimizer::mma: return "barrier-mma";
