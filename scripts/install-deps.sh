@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Installs the Debian packages StokesContact needs, only those that are missing.
 set -euo pipefail
-# nlohmann-json3-dev: scene files (stokescontact-run); python3-vtk9: the test vtk_readback reads
-# the VTK output back with VTK's own reader.
+# nlohmann-json3-dev: scene files (stokescontact-run); python3-vtk9 and python3-numpy: the tests
+# vtk_readback and scene_output_readback read the VTK output back with VTK's own reader and its
+# numpy support (python3-vtk9 does not pull numpy in without its recommended packages).
 packages=(g++ cmake make libeigen3-dev libnlopt-cxx-dev libgtest-dev libbenchmark-dev
-          nlohmann-json3-dev python3-vtk9)
+          nlohmann-json3-dev python3-vtk9 python3-numpy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
