@@ -15,6 +15,9 @@
 #include "scene/scene_run.hpp"
 #include "scene/scene_spec.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace scene_file_tests {
+
 namespace sc = stokescontact;
 namespace apps = stokescontact::apps;
 using nlohmann::json;
@@ -307,3 +310,5 @@ TEST(SceneRun, DefaultOutputIsOutSlashNameMadeWhenMissing) {
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "two_spheres" / "summary.json"));
   std::filesystem::remove_all(dir);
 }
+
+}  // namespace scene_file_tests

@@ -11,6 +11,9 @@
 #include "stokescontact/contact/barrier.hpp"
 #include "common/test_support.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace barrier_tests {
+
 namespace sc = stokescontact;
 using sc::BarrierFunction;
 using sc::BarrierParameters;
@@ -167,3 +170,5 @@ TEST(Barrier, RejectsBadParameters) {
   expect_rejects([] { sc::barrier_parameters(-1.0); }, "d_hat");
   expect_rejects([] { sc::barrier_parameters(1.0, 0.0, 1.0); }, "cap_fraction");
 }
+
+}  // namespace barrier_tests

@@ -11,6 +11,9 @@
 #include "stokescontact/contact/contact_matrix.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace contact_matrix_tests {
+
 namespace sc = stokescontact;
 using test_support::expect_rejects;
 using test_support::uniform;
@@ -364,3 +367,5 @@ TEST(ContactMatrix, RejectsBadInput) {
   const std::vector<sc::ContactColumn> columns = {{0, 2}};
   expect_rejects([&] { sc::assemble_contact_matrix(columns, 2, 6); }, "columns[0]");
 }
+
+}  // namespace contact_matrix_tests

@@ -12,6 +12,9 @@
 #include "stokescontact/contact/contact_pairs.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace contact_pairs_tests {
+
 namespace sc = stokescontact;
 using test_support::expect_rejects;
 using sc::Pose;
@@ -224,3 +227,5 @@ TEST(ContactPairs, RejectsBadInput) {
       },
       "nodes");
 }
+
+}  // namespace contact_pairs_tests

@@ -22,6 +22,9 @@
 #include "stokescontact/contact/solver_default.hpp"
 #include "stokescontact/contact/solver_lcp_sequence.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace contact_solver_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -166,3 +169,5 @@ TEST(BarrierWorkingSet, ModelProblemIsTheSmallestSumOrDissipation) {
   ASSERT_TRUE(none.has_value());
   EXPECT_EQ(none->norm(), 0.0);
 }
+
+}  // namespace contact_solver_tests

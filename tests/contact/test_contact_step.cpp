@@ -21,6 +21,9 @@
 #include "stokescontact/scenes/random.hpp"
 #include "stokescontact/scenes/sphere_packing.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace contact_step_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -557,3 +560,5 @@ TEST(ContactStepAtScale, HundredThousandSpheresInBoundedMemoryWithoutApplication
 }
 
 }  // namespace
+
+}  // namespace contact_step_tests

@@ -22,6 +22,9 @@
 #include "stokescontact/geometry/closest_points.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace contact_step_periodic_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -241,3 +244,5 @@ TEST(ContactStepPeriodic, AForceThatFlingsABodyBeyondTheBoxIsAFailedStepNotAThro
 }
 
 }  // namespace
+
+}  // namespace contact_step_periodic_tests

@@ -21,6 +21,9 @@
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/single_body_mobility.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace contact_step_surface_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -313,3 +316,5 @@ TEST(ContactStepSurface, RejectsANegativeNodeSpacing) {
 }
 
 }  // namespace
+
+}  // namespace contact_step_surface_tests

@@ -24,6 +24,9 @@
 #include "stokescontact/mobility/single_body_mobility.hpp"
 #include "stokescontact/scenes/sphere_packing.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace continuous_detection_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -335,3 +338,5 @@ TEST(GalileanInvariance, RelativeFlagsMatchBruteForceWithAFastBody) {
 }
 
 }  // namespace
+
+}  // namespace continuous_detection_tests

@@ -8,6 +8,9 @@
 #include "common/test_support.hpp"
 #include "stokescontact/contact/d_try.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace d_try_tests {
+
 namespace sc = stokescontact;
 using test_support::expect_rejects;
 using sc::Pose;
@@ -92,3 +95,5 @@ TEST(DTry, RejectsBadInput) {
   expect_rejects([&] { sc::d_try_tip_velocity(0.1, 0.01, sc::Spherocylinder{-1.0, 0.4}, one, u); },
                  "Spherocylinder.length");
 }
+
+}  // namespace d_try_tests

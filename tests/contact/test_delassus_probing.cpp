@@ -17,6 +17,9 @@
 #include "stokescontact/scenes/random.hpp"
 #include "stokescontact/scenes/sphere_packing.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace delassus_probing_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -274,3 +277,5 @@ TEST(DefaultSolver, SqueezedLatticeIsSeparatedAtComplementarity) {
 }
 
 }  // namespace
+
+}  // namespace delassus_probing_tests

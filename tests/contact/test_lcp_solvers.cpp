@@ -19,6 +19,9 @@
 #include "stokescontact/lcp/bbpgd.hpp"
 #include "stokescontact/lcp/minimum_map_newton.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace lcp_solvers_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -475,3 +478,5 @@ TEST(LcpSolvers, LargeSparseProblemAllThreeAgree) {
               1e-5 * std::max(1.0, results[0].gamma.cwiseAbs().maxCoeff()));
   }
 }
+
+}  // namespace lcp_solvers_tests

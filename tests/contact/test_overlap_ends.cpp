@@ -17,6 +17,9 @@
 #include "stokescontact/geometry/overlap_ends.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace overlap_ends_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -259,3 +262,5 @@ TEST(OverlapEnds, BadOptionsNameTheField) {
     EXPECT_NE(std::string(e.what()).find("ContactStepOptions.directions"), std::string::npos) << e.what();
   }
 }
+
+}  // namespace overlap_ends_tests

@@ -18,6 +18,9 @@
 #include "stokescontact/contact/solvers/lcp_sequence.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace parallel_rods_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -241,3 +244,5 @@ TEST(LineContactRods, ContactMatrixActsAtTheLineContact) {
   const auto D = sc::contact_matrix(std::span<const sc::ContactPair>(pairs), std::span<const sc::Pose>(poses));
   EXPECT_NEAR(D.coeff(4, 0), -0.5 * std::cos(alpha), 1e-12);
 }
+
+}  // namespace parallel_rods_tests

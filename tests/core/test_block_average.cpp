@@ -9,6 +9,9 @@
 #include "stokescontact/core/block_average.hpp"
 #include "stokescontact/core/gaussian_stream.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace block_average_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -141,3 +144,5 @@ TEST(BlockAverage, RejectsBadInput) {
 }
 
 }  // namespace
+
+}  // namespace block_average_tests

@@ -7,6 +7,9 @@
 
 #include "stokescontact/core/gaussian_stream.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace gaussian_stream_tests {
+
 namespace sc = stokescontact;
 
 TEST(GaussianStream, SameSeedGivesTheSameStream) {
@@ -62,3 +65,5 @@ TEST(GaussianStream, HasStandardNormalMoments) {
   EXPECT_LT(std::abs(m4 - 3.0), 5.0 * std::sqrt(96.0) / root_n);          // var x^4 = 105 - 9
   EXPECT_LT(std::abs(inside - p), 5.0 * std::sqrt(p * (1.0 - p)) / root_n);
 }
+
+}  // namespace gaussian_stream_tests

@@ -8,6 +8,9 @@
 #include "common/test_support.hpp"
 #include "stokescontact/core/gmres.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace gmres_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -214,3 +217,5 @@ TEST(Gmres, RejectsBadInput) {
     EXPECT_NE(std::string(e.what()).find("GmresOptions.restart"), std::string::npos) << e.what();
   }
 }
+
+}  // namespace gmres_tests

@@ -8,6 +8,9 @@
 #include "common/test_support.hpp"
 #include "stokescontact/core/lanczos.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace lanczos_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -154,3 +157,5 @@ TEST(LanczosSqrt, RejectsBadInput) {
       },
       "operator");
 }
+
+}  // namespace lanczos_tests

@@ -8,6 +8,9 @@
 #include "stokescontact/core/pose.hpp"
 #include "common/test_support.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace pose_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -49,3 +52,5 @@ TEST(Pose, AcceptsQuaternionWithinTolerance) {
   pose.q = sc::Quat(1.0 + 0.5 * sc::kUnitQuaternionTolerance, 0.0, 0.0, 0.0);
   EXPECT_NO_THROW(sc::validate(pose));
 }
+
+}  // namespace pose_tests

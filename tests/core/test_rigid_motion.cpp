@@ -11,6 +11,9 @@
 #include "common/test_support.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace rigid_motion_tests {
+
 namespace sc = stokescontact;
 
 TEST(RigidMotion, QuaternionExpMatchesAngleAxis) {
@@ -119,3 +122,5 @@ TEST(RigidMotion, AdvanceAllRejectsBadInput) {
   expect_rejects([&] { (void)sc::advance_all(poses, sc::VecX::Zero(6), 6, 0.1); }, "velocities");
   EXPECT_THROW((void)sc::advance_all(poses, sc::VecX::Constant(6, std::nan("")), 3, 0.1), std::invalid_argument);
 }
+
+}  // namespace rigid_motion_tests

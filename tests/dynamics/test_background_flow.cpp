@@ -9,6 +9,9 @@
 #include "common/test_support.hpp"
 #include "stokescontact/dynamics/background_flow.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace background_flow_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -122,3 +125,5 @@ TEST(BackgroundFlow, RejectsBadInput) {
 }
 
 }  // namespace
+
+}  // namespace background_flow_tests

@@ -19,6 +19,9 @@
 #include "stokescontact/scenes/periodic_placement.hpp"
 #include "stokescontact/scenes/sphere_packing.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace brownian_stepping_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -225,3 +228,5 @@ TEST(BrownianStepping, RejectsBadInputNamingTheField) {
 }
 
 }  // namespace
+
+}  // namespace brownian_stepping_tests

@@ -17,6 +17,9 @@
 #include "stokescontact/geometry/mass_tensors.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace collision_stress_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -473,3 +476,5 @@ TEST(CollisionStress, ContactObserverSeesCommittedSubStepsOnly) {
 }
 
 }  // namespace
+
+}  // namespace collision_stress_tests

@@ -21,6 +21,9 @@
 #include "stokescontact/dynamics/time_stepper.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace time_stepper_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -621,3 +624,5 @@ TEST(TimeStepper, RejectsBadInputBeforeChangingAnything) {
 }
 
 }  // namespace
+
+}  // namespace time_stepper_tests

@@ -7,6 +7,9 @@
 #include "geometry/brute_force.hpp"
 #include "stokescontact/geometry/arc_distance.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace arc_distance_tests {
+
 namespace sc = stokescontact;
 using sc::Arc;
 using sc::Segment;
@@ -327,3 +330,5 @@ TEST(ArcDistance, ArgumentOrderGivesTheSameDistance) {
     EXPECT_EQ(sa.point_a, as.point_b);
   }
 }
+
+}  // namespace arc_distance_tests

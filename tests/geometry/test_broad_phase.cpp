@@ -19,6 +19,9 @@ namespace stokescontact {
 inline void PrintTo(const BodyPair& p, std::ostream* os) { *os << "(" << p.i << "," << p.j << ")"; }
 }  // namespace stokescontact
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace broad_phase_tests {
+
 namespace {
 
 using namespace stokescontact;
@@ -347,3 +350,5 @@ TEST(BroadPhase, ChecksPerBodyStayBoundedAsNGrows) {
 }
 
 }  // namespace
+
+}  // namespace broad_phase_tests

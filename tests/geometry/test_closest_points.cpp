@@ -10,6 +10,9 @@
 #include "geometry/brute_force.hpp"
 #include "stokescontact/geometry/closest_points.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace closest_points_tests {
+
 namespace sc = stokescontact;
 using brute_force::Rng;
 using brute_force::uniform;
@@ -428,3 +431,5 @@ TEST(ClosestPoints, RejectsBadInput) {
   EXPECT_NE(message([&] { sc::closest_points(curve, 1.0, curve, nan); }).find("radius_b"),
             std::string::npos);
 }
+
+}  // namespace closest_points_tests

@@ -11,6 +11,9 @@
 
 #include "stokescontact/geometry/mass_tensors.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace mass_tensors_tests {
+
 namespace sc = stokescontact;
 using sc::Mat3;
 using sc::Vec3;
@@ -204,3 +207,5 @@ TEST(MassTensors, BoomerangMatchesMonteCarlo) {
   expect_matches_monte_carlo(sc::broms_tornberg_boomerang(), 4'000'000, 4242);
   expect_matches_monte_carlo(sc::Boomerang{2.0, 0.3, 1.1}, 3'000'000, 777);
 }
+
+}  // namespace mass_tensors_tests

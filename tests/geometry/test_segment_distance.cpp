@@ -10,6 +10,9 @@
 #include "stokescontact/geometry/line_contact.hpp"
 #include "stokescontact/geometry/segment_distance.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace segment_distance_tests {
+
 namespace sc = stokescontact;
 using sc::Segment;
 using sc::Vec3;
@@ -417,3 +420,5 @@ TEST(LineContact, ContinuousThroughParallelAndMirroredWhenSwapped) {
   EXPECT_EQ(swapped->normal, Vec3(-straight->normal));
   EXPECT_THROW((void)sc::line_contact(unit_a(), tilted_b(0.0), {0.0, 0.05}), std::invalid_argument);
 }
+
+}  // namespace segment_distance_tests

@@ -7,6 +7,9 @@
 
 #include "stokescontact/geometry/shapes.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace shapes_tests {
+
 namespace sc = stokescontact;
 
 static_assert(sc::Shape<sc::Sphere> && sc::Shape<sc::Spherocylinder> && sc::Shape<sc::Boomerang>);
@@ -88,3 +91,5 @@ TEST(Shapes, BoundingRadiusContainsTheShape) {
   EXPECT_GE(sc::bounding_radius(b), reach + b.radius);
   EXPECT_LT(sc::bounding_radius(b), reach + b.radius + 0.5);
 }
+
+}  // namespace shapes_tests

@@ -13,6 +13,9 @@
 #include "stokescontact/geometry/surface_distances.hpp"
 #include "common/test_support.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace surface_distances_tests {
+
 namespace sc = stokescontact;
 using sc::PairSource;
 using sc::Pose;
@@ -282,3 +285,5 @@ TEST(SurfaceDistances, RandomBoomerangRodPairs) {
   random_configurations(sc::broms_tornberg_boomerang(), 0.1, sc::Spherocylinder{4.0, 0.5}, 0.1, 0.2,
                         6000, 20);
 }
+
+}  // namespace surface_distances_tests

@@ -11,6 +11,9 @@
 #include "stokescontact/geometry/surface_nodes.hpp"
 #include "common/test_support.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace surface_nodes_tests {
+
 namespace sc = stokescontact;
 using sc::Vec3;
 
@@ -158,3 +161,5 @@ TEST(SurfaceNodes, RejectsBadSpacing) {
     EXPECT_NE(what.find("surface nodes"), std::string::npos) << what;
   }
 }
+
+}  // namespace surface_nodes_tests

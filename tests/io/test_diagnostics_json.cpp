@@ -13,6 +13,9 @@
 #include "stokescontact/io/diagnostics_json.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace diagnostics_json_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -106,3 +109,5 @@ TEST(DiagnosticsJson, OneObjectPerLineThroughAStepObserver) {
 }
 
 }  // namespace
+
+}  // namespace diagnostics_json_tests

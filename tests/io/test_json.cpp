@@ -10,6 +10,9 @@
 
 #include "stokescontact/io/json.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace json_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -43,3 +46,5 @@ TEST(Json, StringsEscapeQuotesBackslashesAndControlCharacters) {
 }
 
 }  // namespace
+
+}  // namespace json_tests

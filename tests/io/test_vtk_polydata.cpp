@@ -20,6 +20,9 @@
 #include "stokescontact/geometry/line_contact.hpp"
 #include "stokescontact/io/vtk_polydata.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace vtk_polydata_tests {
+
 namespace sc = stokescontact;
 namespace fs = std::filesystem;
 
@@ -329,3 +332,5 @@ TEST(VtkSeries, RejectsBadInput) {
 }
 
 }  // namespace
+
+}  // namespace vtk_polydata_tests

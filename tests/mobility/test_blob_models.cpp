@@ -13,6 +13,9 @@
 #include "stokescontact/mobility/single_body_mobility.hpp"
 #include "common/test_support.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace blob_models_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -257,3 +260,5 @@ TEST(BlobModel, ValidationNamesTheField) {
   expect_rejects([&] { sc::validate(two); }, "model.positions");
   expect_rejects([] { sc::single_body_mobility(sc::sphere_shell(12, 1.0), -1.0); }, "viscosity");
 }
+
+}  // namespace blob_models_tests

@@ -14,6 +14,9 @@
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/rpy_mobility.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace brownian_velocity_tests {
+
 namespace sc = stokescontact;
 
 // The Brownian slot: free-draining offers an exact square root and divergence, RPY only its
@@ -248,3 +251,5 @@ TEST(BrownianVelocity, RejectsBadInputNamingTheField) {
   expect_rejects([&] { sc::brownian_velocity(model, 1.0, 0.1, W, {-1.0, 10}); }, "LanczosOptions.tolerance");
   expect_rejects([&] { sc::mobility_sqrt(model, sc::VecX::Ones(7)); }, "W");
 }
+
+}  // namespace brownian_velocity_tests

@@ -14,6 +14,9 @@
 #include "stokescontact/mobility/free_draining.hpp"
 #include "mobility/mobility_checks.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace free_draining_tests {
+
 namespace sc = stokescontact;
 
 static_assert(sc::MobilityOperator<sc::FreeDrainingMobility>);
@@ -246,3 +249,5 @@ TEST(FreeDrainingMobility, RefusesBadInput) {
   EXPECT_THROW(m.apply(F), std::invalid_argument);
   EXPECT_EQ(m.applications(), 0u);
 }
+
+}  // namespace free_draining_tests

@@ -17,6 +17,9 @@
 #include "stokescontact/mobility/multiblob_mobility.hpp"
 #include "common/test_support.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace multiblob_mobility_tests {
+
 namespace sc = stokescontact;
 
 static_assert(sc::DenseMobilityOperator<sc::MultiblobMobility>);
@@ -344,3 +347,5 @@ TEST(MultiblobMobility, FreeDrainingFromTheSingleBodyMobilityMatchesOneBody) {
   const sc::MatX a = free_draining.dense_matrix(), b = multiblob.dense_matrix();
   EXPECT_LE((a - b).norm(), 1e-10 * b.norm());
 }
+
+}  // namespace multiblob_mobility_tests

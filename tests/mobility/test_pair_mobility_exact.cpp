@@ -14,6 +14,9 @@
 #include "stokescontact/mobility/pair_mobility_exact.hpp"
 #include "stokescontact/mobility/rpy_mobility.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace pair_mobility_exact_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -256,3 +259,5 @@ TEST(TwoSphereMobility, RefusesContactAndBadInput) {
   EXPECT_THROW(sc::two_sphere_mobility_matrix(sc::Vec3::Zero(), sc::Vec3(3, 0, 0), 0.0, 1.0), std::invalid_argument);
   EXPECT_THROW(sc::two_sphere_mobility_matrix(sc::Vec3::Zero(), sc::Vec3(3, 0, 0), 1.0, -1.0), std::invalid_argument);
 }
+
+}  // namespace pair_mobility_exact_tests

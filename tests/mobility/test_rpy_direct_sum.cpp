@@ -16,6 +16,9 @@
 #include "stokescontact/mobility/rpy_kernel.hpp"
 #include "stokescontact/mobility/rpy_rotation_kernel.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace rpy_direct_sum_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -229,3 +232,5 @@ TEST(RpyDirectSum, RefusesBadInput) {
   }
   EXPECT_EQ(sc::rpy_direct_sum(sc::Mat3X(3, 0), sc::VecX(0), 3).size(), 0);
 }
+
+}  // namespace rpy_direct_sum_tests

@@ -16,6 +16,9 @@
 #include "stokescontact/mobility/rpy_mobility.hpp"
 #include "mobility/mobility_checks.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace rpy_mobility_tests {
+
 namespace sc = stokescontact;
 
 static_assert(sc::MobilityOperator<sc::RpyMobility>);
@@ -231,3 +234,5 @@ TEST(RpyMobility, RefusesBadInput) {
   EXPECT_THROW(m.apply(F), std::invalid_argument);
   EXPECT_EQ(m.applications(), 0u);
 }
+
+}  // namespace rpy_mobility_tests

@@ -14,6 +14,9 @@
 #include "stokescontact/mobility/rpy_mobility.hpp"
 #include "stokescontact/mobility/thermal_drift.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace thermal_drift_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -284,3 +287,5 @@ TEST(ThermalDrift, RejectsBadInputNamingTheField) {
   bad[2].x.x() = nan;
   both([&](auto& m) { sc::random_finite_difference_drift(m, bad, 1.0, stream); }, "poses[2].x");
 }
+
+}  // namespace thermal_drift_tests

@@ -11,6 +11,9 @@
 #include "stokescontact/geometry/closest_points.hpp"
 #include "stokescontact/scenes/periodic_placement.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace periodic_placement_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -70,3 +73,5 @@ TEST(PeriodicPlacement, RejectsABoxTooSmallAndReportsAPackingItCannotFinish) {
 }
 
 }  // namespace
+
+}  // namespace periodic_placement_tests

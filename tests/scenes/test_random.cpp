@@ -13,6 +13,9 @@
 #include "stokescontact/scenes/random.hpp"
 #include "common/test_support.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace random_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -171,3 +174,5 @@ TEST(Random, RejectsBadInputNamingTheField) {
   expect_rejects([&] { sc::random_forces(3, -1.0, rng); }, "magnitude");
   expect_rejects([&] { sc::random_forces(3, nan, rng); }, "magnitude");
 }
+
+}  // namespace random_tests

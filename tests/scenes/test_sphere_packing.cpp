@@ -12,6 +12,9 @@
 #include "stokescontact/scenes/sphere_packing.hpp"
 #include "common/test_support.hpp"
 
+// The whole file in its own namespace: tests of one layer are compiled together (unity build).
+namespace sphere_packing_tests {
+
 namespace sc = stokescontact;
 
 namespace {
@@ -164,3 +167,5 @@ TEST(SpherePacking, RejectsBadInputNamingTheField) {
   o.phi_start = -0.3;
   expect_rejects([&] { sc::dense_packing(10, 0.5, 1, 1.0, o); }, "options.phi_start");
 }
+
+}  // namespace sphere_packing_tests
