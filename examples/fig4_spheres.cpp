@@ -8,6 +8,7 @@
 //                [--d-try-multiplier 1] [--d-try-rule absolute|relative] [--tol TOL] [--dt 0.01]
 //                [--cost formed|matrix-free]
 //                [--separation-margin 1e-3] [--end-of-step] [--pairs] [--output FILE] [--table1]
+//                [--objective sum|dissipation]
 //
 // Prints one JSON object per configuration (to --output if given, else stdout), then a
 // summary table per phi. --tol sets the eq. 29 TOL of the barrier and default solvers (without
@@ -19,7 +20,11 @@
 // returned motion (interior_overlaps) and how deep (interior_min_d_over_d_hat).
 // --table1: the Sec. 3.1.2 sweep d_try x {1, 1.1, 1.2}, TOL in {1e-2, 5e-3, 5e-6} on the
 // first --phi (default 0.24), solver default barrier-slsqp (the paper's), contact forces
-// compared with the reference (d_try x 1, TOL 5e-6).
+// compared with the reference (d_try x 1, TOL 5e-6). With it, each configuration also writes an
+// "extra_pairs" record: lambda / |f| of the pairs flagged at d_try x 1.1 and x 1.2 but not at
+// x 1, at TOL 5e-6 (Fig. 5b with the lambda sum, Fig. 6 with --objective dissipation).
+// --objective: eq. 14's norm for the barrier solvers, sum of lambda (the default) or the
+// dissipation lambda^T D^T M D lambda.
 #include <stokescontact/stokescontact.hpp>
 
 #include <algorithm>
@@ -47,7 +52,7 @@ constexpr const char* kUsage =
     "                    [--d-try-rule absolute|relative] [--tol TOL]\n"
     "                    [--cost formed|matrix-free] [--separation-margin 1e-3] [--end-of-step] [--pairs]\n"
     "                    [--output FILE]\n"
-    "                    [--table1]\n";
+    "                    [--table1] [--objective sum|dissipation]\n";
 
 struct Options {
   int configs = 200;
@@ -73,6 +78,16 @@ Options parse(int argc, char** argv) {
   o.spheres = static_cast<std::size_t>(args.integer("--spheres", 500, 2));
   // Fig. 4 uses the default solver; Table 1 is about the barrier method's TOL (eq. 29).
   o.solver = sc::contact_solver_from_name(args.text("--solver", o.table1 ? "barrier-slsqp" : "default"));
+  const std::string objective = args.text("--objective", "sum");
+  if (objective != "sum" && objective != "dissipation")
+    throw std::invalid_argument("--objective must be sum or dissipation, got '" + objective + "'");
+  if (objective == "dissipation") {
+    auto* barrier = std::get_if<sc::BarrierNloptOptions>(&o.solver);
+    if (!barrier)
+      throw std::invalid_argument("--objective dissipation needs a barrier solver, got '" +
+                                  sc::contact_solver_name(o.solver) + "'");
+    barrier->objective = sc::BarrierObjective::dissipation;
+  }
   o.mobility = ex::parse_mobility(args.text("--mobility", "multiblob"));
   o.step.dt = args.number("--dt", ex::kTimeStep, 0.0);
   sc::require_positive(o.step.dt, "--dt");
@@ -206,10 +221,17 @@ struct ForceDeviation {
   double max_rel_diff() const { return max_ref > 0.0 ? max_diff / max_ref : 0.0; }
 };
 
+// eq. 14's norm of a barrier solver ("sum" for every other solver: they minimise no norm).
+const char* objective_name(const sc::ContactSolver& solver) {
+  const auto* barrier = std::get_if<sc::BarrierNloptOptions>(&solver);
+  return barrier && barrier->objective == sc::BarrierObjective::dissipation ? "dissipation" : "sum";
+}
+
 void print_table1(const Options& o, const std::map<std::pair<int, int>, ForceDeviation>& dev, ex::JsonLines& sink) {
-  std::printf("\nTable 1: %zu spheres, phi %.2f, %d configs, %s mobility, solver %s; reference d_try x 1, TOL 5e-6\n",
+  std::printf("\nTable 1: %zu spheres, phi %.2f, %d configs, %s mobility, solver %s, objective %s; reference d_try x 1, "
+              "TOL 5e-6\n",
               o.spheres, o.phis.front(), o.configs, ex::mobility_name(o.mobility),
-              sc::contact_solver_name(o.solver).c_str());
+              sc::contact_solver_name(o.solver).c_str(), objective_name(o.solver));
   std::printf("%-9s %-8s | %11s %11s | %12s | %9s %9s | %s\n", "d_try", "TOL", "msd", "msd/|f|^2", "max rel diff",
               "med apps", "med Nc", "min d/d_hat after");
   for (const auto& [key, d] : dev) {
@@ -234,6 +256,17 @@ void print_table1(const Options& o, const std::map<std::pair<int, int>, ForceDev
   }
 }
 
+// Fig. 5b / 6: lambda / |f| of the pairs `wider` flags that `reference` (d_try x 1) does not.
+std::vector<double> extra_pair_forces(const ex::StepRecord& reference, const ex::StepRecord& wider) {
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> known = reference.pair_bodies;
+  std::sort(known.begin(), known.end());
+  std::vector<double> extra;
+  for (std::size_t k = 0; k < wider.pair_bodies.size(); ++k)
+    if (!std::binary_search(known.begin(), known.end(), wider.pair_bodies[k]))
+      extra.push_back(wider.pair_lambda_over_f[k]);
+  return extra;
+}
+
 template <sc::MobilityOperator M>
 void run_table1(const Options& o, M& mobility) {
   if (!sc::stopping_tolerance(o.solver))
@@ -246,14 +279,27 @@ void run_table1(const Options& o, M& mobility) {
     const ex::SphereScene scene = ex::make_scene(fig4_scene(o, phi), o.seed + static_cast<std::uint64_t>(c));
     const sc::VecX U = ex::unconstrained_velocities(mobility, scene);
     std::optional<sc::VecX> reference;  // (x 1, 5e-6): the first combination run
+    std::optional<ex::StepRecord> strict_reference;
     for (const int t : {2, 0, 1})
       for (int m = 0; m < 3; ++m) {
         ex::StepSettings settings = o.step;
+        settings.pair_details = true;
         settings.d_try_multiplier = kMultipliers[static_cast<std::size_t>(m)];
         settings.tol = kTols[static_cast<std::size_t>(t)];
-        const ex::StepRecord r = ex::run_step(o.solver, scene, mobility, U, settings);
-        if (!reference) reference = r.sphere_forces;
+        ex::StepRecord r = ex::run_step(o.solver, scene, mobility, U, settings);
+        if (!reference) {
+          reference = r.sphere_forces;
+          strict_reference = r;
+        } else if (t == 2) {
+          sink.line("{\"record\": \"extra_pairs\", \"config\": " + std::to_string(c) +
+                        ", \"d_try_multiplier\": " + sc::json_number(settings.d_try_multiplier) +
+                        ", \"tol\": " + sc::json_number(*settings.tol) + ", \"objective\": \"" +
+                        objective_name(o.solver) + "\", \"lambda_over_f\": " +
+                        sc::json_array(extra_pair_forces(*strict_reference, r)) + "}",
+                    "");
+        }
         deviations[{m, t}].add(r, *reference);
+        r.has_pair_details = o.step.pair_details;  // kept for the extra pairs; written with --pairs
         const std::string extra = ", \"d_try_multiplier\": " + sc::json_number(settings.d_try_multiplier) +
                                   ", \"tol\": " + sc::json_number(*settings.tol);
         char label[64];

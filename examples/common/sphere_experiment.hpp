@@ -18,6 +18,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -154,8 +155,10 @@ struct StepRecord {
   double lambda_max_over_f = 0.0;     // max lambda / |f_i|
   std::string status, message;
   sc::VecX sphere_forces;             // D lambda, the force part only: 3 per sphere
-  // With pair_details: per flagged pair, d at Q* / d_try, d at Q(lambda) / d_hat, lambda / |f|.
+  // With pair_details: per flagged pair, its bodies (i < j), d at Q* / d_try, d at Q(lambda) /
+  // d_hat, lambda / |f|.
   bool has_pair_details = false;
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> pair_bodies;
   std::vector<double> pair_trial_over_d_try, pair_after_over_d_hat, pair_lambda_over_f;
 };
 
@@ -175,6 +178,7 @@ inline void keep_pair_details(const sc::ContactStepResult& r, StepRecord& out) {
     const sc::ContactPair& p = r.pairs[k];
     const double after = sc::closest_points(sphere, r.poses[static_cast<std::size_t>(p.i)], sphere,
                                             r.poses[static_cast<std::size_t>(p.j)]).distance;
+    out.pair_bodies.emplace_back(std::min(p.i, p.j), std::max(p.i, p.j));
     out.pair_trial_over_d_try.push_back(p.points.distance / out.d_try);
     out.pair_after_over_d_hat.push_back(after / out.d_hat);
     out.pair_lambda_over_f.push_back(r.lambda(static_cast<Eigen::Index>(k)) / kForceMagnitude);
