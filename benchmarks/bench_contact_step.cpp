@@ -5,9 +5,14 @@
 // (contact_step.hpp). The scene and U are built once; each iteration is one contact step from
 // the same Q_t. Counters: flagged and pushed pairs, mobility applications, time per sphere.
 // N = 1e6 is registered but takes seconds per iteration: select it with --benchmark_filter.
+// Also the step's two O(N) geometry passes on the same packing (contact/contact_pairs.hpp):
+// detection (find_contact_pairs at d_try = 0.1) and the smallest distance over all pairs
+// (minimum_pair_distance), whose pair loops parallel_for shares out over OpenMP threads
+// (run with OMP_NUM_THREADS=1 and 2 to see their scaling).
 #include <benchmark/benchmark.h>
 
 #include <cstddef>
+#include <map>
 #include <vector>
 
 #include "stokescontact/contact/solvers/defect_correction.hpp"
@@ -51,6 +56,40 @@ void BM_ContactStepBlocks(benchmark::State& state) { run(state, MobilityCost::bl
 void BM_ContactStepMatrixFree(benchmark::State& state) { run(state, MobilityCost::matrix_free); }
 void BM_ContactStepFormed(benchmark::State& state) { run(state, MobilityCost::formed); }
 
+// The packing of N spheres of run(), built once per size.
+const SpherePacking& packing_of(std::size_t n) {
+  static std::map<std::size_t, SpherePacking> cache;
+  auto it = cache.find(n);
+  if (it == cache.end()) it = cache.emplace(n, random_sequential_addition(n, 0.3, n)).first;
+  return it->second;
+}
+
+void BM_FindContactPairs(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const SpherePacking& packing = packing_of(n);
+  CellList cells;
+  std::size_t flagged = 0;
+  for (auto _ : state) {
+    const std::vector<ContactPair> pairs = find_contact_pairs(Sphere{1.0}, packing.poses, 0.1, {}, &cells);
+    benchmark::DoNotOptimize(pairs.data());
+    flagged = pairs.size();
+  }
+  state.counters["flagged"] = static_cast<double>(flagged);
+  state.counters["time_per_sphere"] = benchmark::Counter(
+      static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+void BM_MinimumPairDistance(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const SpherePacking& packing = packing_of(n);
+  CellList cells;
+  for (auto _ : state) benchmark::DoNotOptimize(minimum_pair_distance(Sphere{1.0}, packing.poses, {}, &cells).distance);
+  state.counters["time_per_sphere"] = benchmark::Counter(
+      static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+BENCHMARK(BM_FindContactPairs)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MinimumPairDistance)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ContactStepBlocks)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ContactStepMatrixFree)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
 // Formed holds one dense column of M D per working-set pair: O(N x pairs), 1e4 at most here.

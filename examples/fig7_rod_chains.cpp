@@ -9,8 +9,12 @@
 //
 //   fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat 1e-4,3e-4,...,1e-1]
 //                   [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
-//                   [--directions particle|surface|line|overlap-ends] [--output FILE] [--scene FILE]
+//                   [--directions particle|surface|line|overlap-ends] [--cost automatic|blocks|formed|matrix-free]
+//                   [--output FILE] [--scene FILE]
 //
+// --cost: the contact step's cost mode (ContactStepOptions::cost; automatic takes blocks for
+// free-draining rods: no mobility application); matrix-free counts applications as the
+// speed-versus-error table does.
 // --scene FILE writes the first chain at the first d_hat as a scene file for stokescontact-run
 // (its poses, the pushes as per-body forces, one step; docs/scenes.md) and runs nothing else:
 // examples/scenes/rod_chain.json is `fig7_rod_chains --d-hat 1e-2 --scene FILE`.
@@ -45,7 +49,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat LIST] [--solver NAME]\n"
     "                       [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
-    "                       [--directions particle|surface|line|overlap-ends] [--output FILE] [--scene FILE]\n";
+    "                       [--directions particle|surface|line|overlap-ends] [--cost automatic|blocks|formed|matrix-free]\n"
+    "                       [--output FILE] [--scene FILE]\n";
 
 constexpr double kLRod = 0.5, kRRod = kLRod / 20.0, kDt = 0.05;  // Sec. 3.2.2
 
@@ -58,6 +63,7 @@ struct Options {
   ex::RodMobilityModel mobility = ex::RodMobilityModel::free_draining;
   int blobs_per_ring = 8;
   ex::RodDirections directions = ex::RodDirections::particle;
+  sc::MobilityCost cost = sc::MobilityCost::automatic;
   std::string output;
   std::string scene;
 };
@@ -73,6 +79,7 @@ Options parse(int argc, char** argv) {
   o.mobility = ex::parse_rod_mobility(args.text("--mobility", "free-draining"));
   o.blobs_per_ring = static_cast<int>(args.integer("--blobs-per-ring", 8, 3));
   o.directions = ex::parse_directions(args.text("--directions", "particle"));
+  o.cost = sc::mobility_cost_from_name(args.text("--cost", "automatic"), "--cost");
   o.output = args.text("--output", "");
   o.scene = args.text("--scene", "");
   args.reject_unknown();
@@ -161,6 +168,7 @@ void run_d_hat(const Options& o, const S& rod, double d_hat, M& mobility, ex::Js
     const sc::ContactStepProblem<S> problem{shapes, c.poses, U, kDt, d_hat, 0.0, 1.0, {}};
     sc::ContactStepOptions options;
     options.directions = ex::contact_directions(o.directions);
+    options.cost = o.cost;
     const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, options, o.solver);
     const std::vector<sc::Pose> trial = sc::advance_all(std::span<const sc::Pose>(c.poses), U, 6, kDt);  // Q*, eq. 16
     std::vector<double> before, after, force;
@@ -187,11 +195,16 @@ void run_d_hat(const Options& o, const S& rod, double d_hat, M& mobility, ex::Js
                   d_hat, chain, c.beta, r.flagged_pairs, r.min_distance_ratio, r.mobility_applications,
                   std::string(sc::to_string(r.status)).c_str());
     sink.line("{\"record\": \"chain\", \"d_hat\": " + sc::json_number(d_hat) + ", \"chain\": " + std::to_string(chain) +
-                  ", \"rods\": " + std::to_string(o.rods) + ", \"beta\": " + sc::json_number(c.beta) +
+                  ", \"rods\": " + std::to_string(o.rods) + ", \"solver\": \"" + sc::contact_solver_name(o.solver) +
+                  "\", \"mobility\": \"" + ex::rod_mobility_name(o.mobility) + "\", \"directions\": \"" +
+                  ex::directions_name(o.directions) + "\", \"cost\": \"" + sc::mobility_cost_name(r.cost) +
+                  "\", \"beta\": " + sc::json_number(c.beta) +
                   ", \"redraws\": " + std::to_string(c.redraws) + ", \"f\": " + sc::json_number(f) +
                   ", \"d_try\": " + sc::json_number(r.d_try) + ", \"nc\": " + std::to_string(r.flagged_pairs) +
                   ", \"mobility_applications\": " + std::to_string(r.mobility_applications) +
-                  ", \"min_d_over_d_hat\": " + sc::json_number(r.min_distance_ratio) + ", \"status\": \"" +
+                  ", \"min_d_over_d_hat\": " + sc::json_number(r.min_distance_ratio) +
+                  ", \"lambda_sum\": " + sc::json_number(r.lambda_sum) + ", \"wall_time_s\": " +
+                  sc::json_number(r.wall_time_s) + ", \"status\": \"" +
                   std::string(sc::to_string(r.status)) + "\", \"d_before\": " + sc::json_array(before) +
                   ", \"d_after\": " + sc::json_array(after) + ", \"lambda_over_f\": " + sc::json_array(force) + "}",
               progress);

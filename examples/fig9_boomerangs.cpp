@@ -181,7 +181,7 @@ void run(const Options& o, M& mobility) {
         ", \"boomerangs\": " + std::to_string(o.boomerangs) + ", \"side\": " + sc::json_number(o.side) +
         ", \"mobility\": \"" + o.mobility + "\", \"blob_model\": \"" + o.blob_model +
         "\", \"blobs_per_body\": " + std::to_string(mobility_blobs) + ", \"solver\": \"" + sc::contact_solver_name(o.solver) +
-        "\", \"directions\": \"" + (o.step.directions == sc::ContactDirections::surface ? "surface" : "particle") +
+        "\", \"cost\": \"" + sc::mobility_cost_name(r.cost) + "\", \"directions\": \"" + (o.step.directions == sc::ContactDirections::surface ? "surface" : "particle") +
         "\", \"d_hat\": " + sc::json_number(d_hat) + ", \"d_try\": " + sc::json_number(r.d_try) +
         ", \"flagged\": " + std::to_string(r.flagged_pairs) + ", \"min_d_over_d_hat_after\": " +
         sc::json_number(r.min_distance_ratio) + ", \"pair_d_before\": " + sc::json_array(std::span<const double>(before)) +

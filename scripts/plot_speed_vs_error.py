@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Cost of a contact step versus its error per solver and scene, from speed_vs_error's JSON lines.
 
-usage: scripts/plot_speed_vs_error.py SPEED_VS_ERROR.jsonl docs/figures/speed_vs_error.png
+usage: scripts/plot_speed_vs_error.py SPEED_VS_ERROR.jsonl [MORE.jsonl ...] docs/figures/speed_vs_error.png
+
+The inputs are speed_vs_error's rows and, in the same format, those of
+scripts/speed_vs_error_shapes.py (the rod and boomerang scenes).
 
 One point per (scene, solver, cost mode): the median over the scene's configurations of the
 wall time (left) and of the mobility applications (right), against the worst error over them,
@@ -37,13 +40,13 @@ def groups(rows):
     return out
 
 
-def main(source, target):
-    rows = [json.loads(line) for line in open(source) if line.strip()]
+def main(sources, target):
+    rows = [json.loads(line) for source in sources for line in open(source) if line.strip()]
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     solvers = list(dict.fromkeys(r["solver"] for r in rows))
     colours = {s: f"C{k}" for k, s in enumerate(scenes)}
     markers = {s: MARKERS[k % len(MARKERS)] for k, s in enumerate(solvers)}
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), sharex=True)
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2), sharex=True)
     for (scene, solver, cost), rs in groups(rows).items():
         x = max(error(r) for r in rs)
         for ax, key in zip(axes, ("wall_time_s", "mobility_applications")):
@@ -67,6 +70,6 @@ def main(source, target):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if len(sys.argv) < 3:
         sys.exit(__doc__)
-    main(sys.argv[1], sys.argv[2])
+    main(sys.argv[1:-1], sys.argv[-1])

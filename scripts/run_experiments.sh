@@ -47,8 +47,21 @@ for part in "${parts[@]}"; do
       $bin/fig9_boomerangs --resolution --output $data/fig9_resolution.jsonl | tee $data/fig9_resolution.txt ;;
     fig9-surface-blobs)  # resolved multiblob boomerangs (236 blobs each): ~40 s per configuration
       run fig9_multiblob_surface_default $bin/fig9_boomerangs --mobility multiblob --blob-model surface --configs 10 ;;
-    speed)
-      run speed_vs_error $bin/speed_vs_error --mobility rpy --configs 10 --jammed-spheres 100 ;;
+    speed)  # every solver on the sphere, rod-chain and boomerang scenes (about 8 minutes)
+      run speed_vs_error $bin/speed_vs_error --mobility rpy --configs 10 --jammed-spheres 100
+      runs=$(mktemp -d)
+      for solver in default lcp-bbpgd lcp-apgd lcp-newton barrier-slsqp barrier-mma barrier-working-set; do
+        $bin/fig7_rod_chains --cost matrix-free --solver $solver --output "$runs/fig7_$solver.jsonl" >/dev/null
+        $bin/fig9_boomerangs --mobility free-draining --cost matrix-free --solver $solver \
+          --output "$runs/fig9_fd_$solver.jsonl" >/dev/null
+        $bin/fig9_boomerangs --mobility multiblob --cost matrix-free --solver $solver \
+          --output "$runs/fig9_mb_$solver.jsonl" >/dev/null
+      done
+      /usr/bin/python3 scripts/speed_vs_error_shapes.py $data/speed_vs_error_shapes.jsonl "$runs"/*.jsonl \
+        | tee $data/speed_vs_error_shapes.txt
+      rm -r "$runs"
+      /usr/bin/python3 scripts/plot_speed_vs_error.py $data/speed_vs_error.jsonl $data/speed_vs_error_shapes.jsonl \
+        docs/figures/speed_vs_error.png ;;
     whole-step)  # no tunnelling, Galilean invariance, detection cost (~5 minutes)
       run fig4_rpy_end_of_step $bin/fig4_spheres --mobility rpy --end-of-step
       run fig4_rpy_whole_step $bin/fig4_spheres --mobility rpy

@@ -418,6 +418,40 @@ TEST(ContactStep, DenseSceneWithSmallDTryIsSeparatedByTheGuaranteeLoop) {
   }
 }
 
+// A jammed cluster (100 spheres compressed to packing 0.55, scenes/sphere_packing.hpp, d_hat =
+// the smallest gap, random |f| = 100): hundreds of flagged pairs in one connected network,
+// where the working set's smallest sum can leave complementarity (pairs pushed that end
+// apart). eq. 15 on the working set must separate it as the default does, with no more force.
+TEST(ContactStep, JammedClusterIsSeparatedByTheWorkingSetBarrier) {
+  for (const std::uint64_t seed : {3u, 4u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    std::mt19937_64 rng(seed);
+    const sc::SpherePacking packing = sc::dense_packing(100, 0.55, rng());
+    const std::vector<sc::Vec3> forces = sc::random_forces(100, 100.0, rng);
+    SphereScene s;
+    s.poses = packing.poses;
+    s.d_hat = packing.min_gap;
+    s.dt = 0.01;
+    s.U.resize(300);
+    for (std::size_t i = 0; i < 100; ++i) s.U.segment<3>(3 * static_cast<Eigen::Index>(i)) = kMu * forces[i];
+    auto m0 = s.mobility();
+    auto m1 = s.mobility();
+    const sc::ContactStepResult def = run(Solver::kDefault, s.problem(), m0);
+    const sc::ContactStepResult bws = run(Solver::kBarrierWorkingSet, s.problem(), m1);
+    print("jammed seed " + std::to_string(seed), Solver::kDefault, def);
+    print("jammed seed " + std::to_string(seed), Solver::kBarrierWorkingSet, bws);
+    ASSERT_GE(def.flagged_pairs, 150u);  // a network, not a few pairs
+    for (const sc::ContactStepResult* r : {&def, &bws}) {
+      EXPECT_EQ(r->status, sc::ContactStepStatus::converged) << r->message;
+      EXPECT_GE(r->min_distance_ratio, 1.0 - 1e-9);
+      EXPECT_GE(r->lambda.minCoeff(), 0.0);
+      expect_third_law(*r, 3);
+    }
+    EXPECT_LE(bws.lambda_sum, def.lambda_sum * (1.0 + kDefaultLambdaTolerance));
+    EXPECT_GE(bws.lambda_sum, def.lambda_sum * 0.9);  // the same network held: the same order of force
+  }
+}
+
 // The cost mode follows the model: blocks for a block-diagonal one (free draining); for any
 // other, formed up to automatic_formed_max_pairs flagged pairs and matrix_free beyond. blocks
 // asked of a model without blocks is refused, naming the option.
@@ -489,9 +523,19 @@ TEST(ContactStep, RejectsBadInputNamingTheFieldAndChangesNothing) {
   sc::LcpSequenceOptions seq;
   seq.max_iterations = 0;
   expect_rejects([&] { (void)sc::solve_contact_step_lcp_sequence(p, m, {}, seq); }, "LcpSequenceOptions.max_iterations");
-  sc::BarrierNloptOptions bar;
-  bar.tol = 0.0;
-  expect_rejects([&] { (void)sc::solve_contact_step_barrier(p, m, {}, bar); }, "BarrierNloptOptions.tol");
+  const auto reject_barrier = [&](auto change, const std::string& field) {
+    sc::BarrierNloptOptions bar;
+    change(bar);
+    expect_rejects([&] { (void)sc::solve_contact_step_barrier(p, m, {}, bar); }, field);
+  };
+  reject_barrier([](sc::BarrierNloptOptions& b) { b.tol = 0.0; }, "BarrierNloptOptions.tol");
+  reject_barrier([](sc::BarrierNloptOptions& b) { b.eps_reg = std::nan(""); }, "BarrierNloptOptions.eps_reg");
+  reject_barrier([](sc::BarrierNloptOptions& b) { b.max_evaluations = 0; }, "BarrierNloptOptions.max_evaluations");
+  reject_barrier([](sc::BarrierNloptOptions& b) { b.cap_fraction = 1.0; }, "BarrierNloptOptions.cap_fraction");
+  reject_barrier([](sc::BarrierNloptOptions& b) {  // the working set's model problems need SLSQP
+    b.constraint = sc::BarrierConstraint::working_set;
+    b.optimizer = sc::BarrierOptimizer::cobyla;
+  }, "BarrierNloptOptions.optimizer");
   sc::DefectCorrectionOptions def;
   def.probe_radius_factor = 0.0;
   expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(p, m, {}, def); }, "DefectCorrectionOptions.probe_radius_factor");

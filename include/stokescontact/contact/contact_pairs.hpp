@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "stokescontact/contact/scene.hpp"
+#include "stokescontact/core/parallel_for.hpp"
 #include "stokescontact/geometry/broad_phase.hpp"
 #include "stokescontact/geometry/closest_points.hpp"
 #include "stokescontact/geometry/line_contact.hpp"
@@ -43,6 +44,23 @@ struct ContactPair {
 inline Pose shifted(const Pose& pose, const Vec3& shift) { return {pose.x + shift, pose.q}; }
 
 namespace detail {
+
+// The broad phase's candidates measured in chunks (parallel_for within a chunk, so memory
+// stays bounded by the chunk), handed to `use` in candidate order: the serial loop's results.
+template <class Measure, class Use>
+void measure_candidates(const std::vector<BodyPair>& candidates, Measure&& measure, Use&& use) {
+  constexpr std::size_t kChunk = 16384;
+  using Result = decltype(measure(candidates.front()));
+  std::vector<Result> measured;
+  for (std::size_t first = 0; first < candidates.size(); first += kChunk) {
+    const std::size_t count = std::min(kChunk, candidates.size() - first);
+    measured.resize(count);
+    parallel_for(static_cast<std::ptrdiff_t>(count), [&](std::ptrdiff_t k) {
+      measured[static_cast<std::size_t>(k)] = measure(candidates[first + static_cast<std::size_t>(k)]);
+    });
+    for (std::size_t k = 0; k < count; ++k) use(candidates[first + k], measured[k]);
+  }
+}
 
 template <Shape S>
 void broad_phase_input(std::span<const S> shapes, std::span<const Pose> poses, Mat3X& centres, VecX& radii) {
@@ -163,10 +181,12 @@ std::vector<ContactPair> find_contact_pairs(std::span<const S> shapes, std::span
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
   std::vector<ContactPair> flagged;
-  for (const BodyPair& c : list.find_pairs(centres, radii, d_try, box)) {
-    ContactPair pair = detail::contact_pair(shapes, poses, c.i, c.j, box);
-    if (pair.points.distance <= d_try) flagged.push_back(pair);
-  }
+  detail::measure_candidates(
+      list.find_pairs(centres, radii, d_try, box),
+      [&](const BodyPair& c) { return detail::contact_pair(shapes, poses, c.i, c.j, box); },
+      [&](const BodyPair&, ContactPair& pair) {
+        if (pair.points.distance <= d_try) flagged.push_back(std::move(pair));
+      });
   return flagged;
 }
 
@@ -207,20 +227,20 @@ MinimumDistance minimum_pair_distance(std::span<const S> shapes, std::span<const
     reach = std::max(0.0, half - (r_max + r_max));
     while (reach > 0.0 && (r_max + r_max) + reach > half) reach = std::nextafter(reach, 0.0);
   }
-  auto consider = [&](Eigen::Index i, Eigen::Index j) {
-    const double d = detail::contact_pair(shapes, poses, i, j, box).points.distance;
-    if (d < best.distance) best = {d, i, j};
+  auto distance = [&](const BodyPair& c) { return detail::contact_pair(shapes, poses, c.i, c.j, box).points.distance; };
+  auto consider = [&](const BodyPair& c, double d) {
+    if (d < best.distance) best = {d, c.i, c.j};
   };
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
   for (double cutoff = std::min(r_max, reach);; cutoff = std::min(4.0 * cutoff, reach)) {
-    for (const BodyPair& c : list.find_pairs(centres, radii, cutoff, box)) consider(c.i, c.j);
+    detail::measure_candidates(list.find_pairs(centres, radii, cutoff, box), distance, consider);
     if (best.distance <= cutoff || (!box && cutoff == reach)) return best;
     if (cutoff == reach) break;
   }
   const auto n = static_cast<Eigen::Index>(poses.size());  // periodic, nothing within reach
   for (Eigen::Index i = 0; i < n; ++i)
-    for (Eigen::Index j = i + 1; j < n; ++j) consider(i, j);
+    for (Eigen::Index j = i + 1; j < n; ++j) consider({i, j}, distance({i, j}));
   return best;
 }
 

@@ -83,6 +83,7 @@
 #include "stokescontact/contact/continuous_detection.hpp"
 #include "stokescontact/contact/d_try.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
+#include "stokescontact/core/parallel_for.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 #include "stokescontact/mobility/mobility_operator.hpp"
 
@@ -448,25 +449,27 @@ class ContactStep {
     const auto n = problem_.poses.size();
     std::vector<char> moved(n, 0);
     e.poses = trial_;
-    for (std::size_t b = 0; b < n; ++b) {
-      const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs_;
-      if (e.MD_lambda.segment(row, dofs_).isZero(0.0)) continue;
+    parallel_for(static_cast<std::ptrdiff_t>(n), [&](std::ptrdiff_t body) {
+      const auto b = static_cast<std::size_t>(body);
+      const Eigen::Index row = body * dofs_;
+      if (e.MD_lambda.segment(row, dofs_).isZero(0.0)) return;
       moved[b] = 1;
       const Vec3 omega = dofs_ == 6 ? Vec3(V.segment<3>(row + 3)) : Vec3::Zero();
       e.poses[b] = advance(problem_.poses[b], V.segment<3>(row), omega, problem_.dt);  // eq. 13
-    }
-    e.pairs.reserve(pairs_.size());
+    });
+    e.pairs.resize(pairs_.size());
     e.distances.resize(nc());
-    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    parallel_for(nc(), [&](std::ptrdiff_t index) {
+      const auto k = static_cast<std::size_t>(index);
       const ContactPair& p = pairs_[k];
       if (carried_[k])
-        e.pairs.push_back(carried_at(*carried_[k], p, V, std::span<const Pose>(e.poses)));
+        e.pairs[k] = carried_at(*carried_[k], p, V, std::span<const Pose>(e.poses));
       else if (k < at_trial_.size() && !moved[static_cast<std::size_t>(p.i)] && !moved[static_cast<std::size_t>(p.j)])
-        e.pairs.push_back(at_trial_[k]);
+        e.pairs[k] = at_trial_[k];
       else
-        e.pairs.push_back(remeasured(p, problem_.shapes, std::span<const Pose>(e.poses), problem_.box));
-      e.distances(static_cast<Eigen::Index>(k)) = e.pairs.back().points.distance;
-    }
+        e.pairs[k] = remeasured(p, problem_.shapes, std::span<const Pose>(e.poses), problem_.box);
+      e.distances(index) = e.pairs[k].points.distance;
+    });
     return e;
   }
 
