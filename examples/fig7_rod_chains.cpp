@@ -203,7 +203,8 @@ void run_d_hat(const Options& o, const S& rod, double d_hat, M& mobility, ex::Js
                   ", \"d_try\": " + sc::json_number(r.d_try) + ", \"nc\": " + std::to_string(r.flagged_pairs) +
                   ", \"mobility_applications\": " + std::to_string(r.mobility_applications) +
                   ", \"min_d_over_d_hat\": " + sc::json_number(r.min_distance_ratio) +
-                  ", \"lambda_sum\": " + sc::json_number(r.lambda_sum) + ", \"wall_time_s\": " +
+                  ", \"lambda_sum\": " + sc::json_number(r.lambda_sum) +
+                  ", \"max_correction_turn\": " + sc::json_number(r.max_correction_turn) + ", \"wall_time_s\": " +
                   sc::json_number(r.wall_time_s) + ", \"status\": \"" +
                   std::string(sc::to_string(r.status)) + "\", \"d_before\": " + sc::json_array(before) +
                   ", \"d_after\": " + sc::json_array(after) + ", \"lambda_over_f\": " + sc::json_array(force) + "}",

@@ -8,7 +8,7 @@
 //                [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
 //                [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]
 //                [--line-angle 0.05] [--cost formed|matrix-free|blocks|automatic] [--max-steps N] [--tilt 0]
-//                [--max-iterations N] [--output FILE]
+//                [--max-iterations N] [--max-correction-turn 0.5] [--output FILE]
 //
 // --d-hat is in units of R_rod. --directions: the paper's d^P ("particle", eq. 20-21) and d^S
 // ("surface", eq. 22-23, node spacing R_rod / 2 unless --node-spacing), or "line": d^P
@@ -25,6 +25,8 @@
 // --max-steps stops each run early (a measured partial run of an expensive model). --tilt
 // turns rod k by (-1)^k (k + 1) / N times the given angle about x at t = 0: a perturbation of
 // the symmetric start, to see whether the contacts restore or amplify it.
+// --max-correction-turn: ContactStepOptions::max_correction_turn in radians (a step whose
+// correction turns a rod further is refused and sub-stepped; a large value lifts the guard).
 #include <stokescontact/stokescontact.hpp>
 
 #include <algorithm>
@@ -53,7 +55,7 @@ constexpr const char* kUsage =
     "                    [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
     "                    [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]\n"
     "                    [--line-angle 0.05] [--cost formed|matrix-free|blocks|automatic] [--max-steps N] [--tilt 0]\n"
-    "                    [--max-iterations N] [--output FILE]\n";
+    "                    [--max-iterations N] [--max-correction-turn 0.5] [--output FILE]\n";
 
 constexpr double kLRod = 2.0, kRRod = kLRod / 4.0;  // Sec. 3.2.3
 
@@ -95,6 +97,7 @@ Options parse(int argc, char** argv) {
   o.step.cost = sc::mobility_cost_from_name(args.text("--cost", "formed"), "--cost");
   o.max_steps = static_cast<long>(args.integer("--max-steps", 0, 0));
   o.tilt = args.number("--tilt", 0.0);
+  o.step.max_correction_turn = args.number("--max-correction-turn", o.step.max_correction_turn, 1e-12);
   // The solver's iteration limit per round (LCPs of the LCP sequence, corrections of the
   // default solver); without it each keeps its own (20, 50).
   if (const auto limit = args.positive("--max-iterations")) {
@@ -224,6 +227,8 @@ RunSummary run(const Options& o, const S& rod, double fraction, double dt, M& mo
                   ", \"mobility_applications\": " + std::to_string(d.mobility_applications) +
                   ", \"wall_time_s\": " + sc::json_number(d.wall_time_s) + ", \"S\": " + sc::json_number(order) +
                   ", \"max_abs_x\": " + sc::json_number(max_x) + ", \"max_turn\": " + sc::json_number(max_turn) +
+                  ", \"max_correction_turn\": " + sc::json_number(d.max_correction_turn) +
+                  ", \"substeps\": " + std::to_string(d.substeps) +
                   ", \"min_d_over_d_hat\": " + sc::json_number(d.min_distance_ratio) + ", \"status\": \"" +
                   std::string(sc::to_string(d.status)) + "\"}");
   }
@@ -234,7 +239,8 @@ RunSummary run(const Options& o, const S& rod, double fraction, double dt, M& mo
 std::string summary_json(const Options& o, const RunSummary& s) {
   return "{\"record\": \"summary\", \"rods\": " + std::to_string(o.rows * o.columns) + ", \"mobility\": \"" +
          ex::rod_mobility_name(o.mobility) + "\", \"solver\": \"" + sc::contact_solver_name(o.solver) +
-         "\", \"directions\": \"" + ex::directions_name(o.directions) + "\", \"d_hat_over_R\": " +
+         "\", \"directions\": \"" + ex::directions_name(o.directions) +
+         "\", \"max_correction_turn_bound\": " + sc::json_number(o.step.max_correction_turn) + ", \"d_hat_over_R\": " +
          sc::json_number(s.d_hat_fraction) + ", \"dt\": " + sc::json_number(s.dt) +
          ", \"steps\": " + std::to_string(s.steps) + ", \"triggered\": " + std::to_string(s.triggered) +
          ", \"paper_triggered\": " + std::to_string(paper_count(s.dt, s.d_hat_fraction, false)) +

@@ -188,7 +188,7 @@ void run(const Options& o, M& mobility) {
         ", \"pair_d_after\": " + sc::json_array(std::span<const double>(after)) + ", \"status\": \"" +
         std::string(sc::to_string(r.status)) + "\", \"applications\": " + std::to_string(r.mobility_applications) +
         ", \"iterations\": " + std::to_string(r.iterations) + ", \"lambda_sum\": " + sc::json_number(r.lambda_sum) +
-        ", \"wall_time_s\": " + sc::json_number(r.wall_time_s) + ", \"message\": " + sc::json_quoted(r.message) + "}";
+        ", \"max_correction_turn\": " + sc::json_number(r.max_correction_turn) + ", \"wall_time_s\": " + sc::json_number(r.wall_time_s) + ", \"message\": " + sc::json_quoted(r.message) + "}";
     char progress[200];
     std::snprintf(progress, sizeof progress, "config %3d: d_hat %.3e Nc %3zu min d/d_hat %.6f apps %3zu %7.3f s %s", c,
                   d_hat, r.flagged_pairs, r.min_distance_ratio, r.mobility_applications, r.wall_time_s,

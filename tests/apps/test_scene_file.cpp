@@ -91,6 +91,15 @@ TEST(SceneFile, EndTimeRoundsToWholeSteps) {
   EXPECT_EQ(apps::read_scene(j).steps, 450);
 }
 
+TEST(SceneFile, CorrectionTurnBoundIsRead) {
+  json j = two_spheres();
+  EXPECT_EQ(apps::read_scene(j).contact.step.max_correction_turn, sc::ContactStepOptions{}.max_correction_turn);
+  j["contact"]["max_correction_turn"] = 0.25;
+  EXPECT_EQ(apps::read_scene(j).contact.step.max_correction_turn, 0.25);
+  j["contact"]["max_correction_turn"] = 0.0;
+  expect_error(j, "contact.max_correction_turn", "must be > 0");
+}
+
 TEST(SceneFile, BadInputNamesTheKeyPath) {
   json j = two_spheres();
   j["shape"]["radius"] = -1;

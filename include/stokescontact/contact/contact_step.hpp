@@ -57,7 +57,10 @@
 // linearisation needs at its start, while inside a step only overlap is unphysical; a
 // rotating body held at d_hat at the end may come closer inside without touching. The step
 // is then re-solved, warm-started. One that still violates either reports failed_separation
-// with the numbers, never silently (the time stepper then sub-steps by default).
+// with the numbers, never silently (the time stepper then sub-steps by default). So does a
+// step whose correction turns a body by more than ContactStepOptions::max_correction_turn:
+// eq. 13 is linear in the rotation, and a crossing pair of rods can have a far root (lambda
+// thousands of times the push, a turn of radians) whose end gaps all hold.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -71,6 +74,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -147,6 +151,12 @@ struct ContactStepOptions {
   // overlap_ends: pairs of rods whose centre lines meet below this angle (radians) are held
   // at both ends of their overlap.
   double overlap_ends_angle = 0.1;
+  // The largest turn dt |omega_c| the contact correction M D lambda may give a body in one
+  // step, in radians. Eq. 13 is linear in the rotation, so a correction turning a body by
+  // radians to hold a gap of d_hat is a root of the linearised problem, not a motion: a step
+  // that needs more reports failed_separation (the stepper then sub-steps). Bodies without
+  // rotational degrees of freedom (spheres) never turn.
+  double max_correction_turn = 0.5;
 
   void validate() const {
     if (!(separation_margin >= 0.0 && separation_margin < 1.0))
@@ -159,6 +169,9 @@ struct ContactStepOptions {
     if (!(overlap_ends_angle > 0.0 && overlap_ends_angle <= 0.5 * std::numbers::pi))
       fail_argument("ContactStepOptions.overlap_ends_angle",
                     "must lie in (0, pi/2], got " + std::to_string(overlap_ends_angle));
+    if (!(max_correction_turn > 0.0))
+      fail_argument("ContactStepOptions.max_correction_turn",
+                    "must be > 0 radians, got " + std::to_string(max_correction_turn));
   }
 
   // Whether a scene of shape S uses d^S for its contact directions.
@@ -206,6 +219,8 @@ struct ContactStepResult {
   std::size_t flagged_pairs = 0;        // Nc
   std::size_t carried_pairs = 0;        // of them, constrained where they first came within d_hat
   int guarantee_rounds = 0;             // re-solves after adding missed pairs
+  double max_correction_turn = 0.0;     // max over bodies of dt |omega| of M D lambda, radians
+  Eigen::Index max_correction_turn_body = -1;  // the body that turns most (-1: none turns)
 };
 
 // What a solver's core returns for one round: lambda and its own convergence.
@@ -687,6 +702,19 @@ inline double complementarity_residual(const VecX& lambda, const VecX& distances
   return r;
 }
 
+// The largest turn dt |omega| the correction velocities MD_lambda (per body: 3 translational,
+// then 3 rotational dofs) give a body, and that body; (0, -1) without rotational dofs.
+inline std::pair<double, Eigen::Index> max_correction_turn(const VecX& MD_lambda, Eigen::Index dofs_per_body,
+                                                           double dt) {
+  std::pair<double, Eigen::Index> out{0.0, -1};
+  if (dofs_per_body != 6) return out;
+  for (Eigen::Index b = 0; b < MD_lambda.size() / 6; ++b) {
+    const double turn = dt * MD_lambda.segment<3>(6 * b + 3).norm();
+    if (turn > out.first) out = {turn, b};
+  }
+  return out;
+}
+
 inline VecX padded(const VecX& lambda, Eigen::Index size) {
   VecX out = VecX::Zero(size);
   out.head(std::min(size, lambda.size())) = lambda.head(std::min(size, lambda.size()));
@@ -760,10 +788,17 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   r.lambda_max = r.lambda.size() == 0 ? 0.0 : r.lambda.maxCoeff();
   r.mobility_applications = step.applications();
   r.cost = step.cost();
-  if (!violating.empty() || !crossing.empty() || !beyond_box.empty()) {
+  std::tie(r.max_correction_turn, r.max_correction_turn_body) =
+      detail::max_correction_turn(e.MD_lambda, step.dofs_per_body(), problem.dt);
+  const bool over_turned = r.max_correction_turn > options.max_correction_turn;
+  if (!violating.empty() || !crossing.empty() || !beyond_box.empty() || over_turned) {
     std::ostringstream os;
     os << "failed separation after " << r.guarantee_rounds << " guarantee round(s):";
     if (!beyond_box.empty()) os << " the corrected motion: " << beyond_box << ";";
+    if (over_turned)
+      os << " the correction turns body " << r.max_correction_turn_body << " by " << r.max_correction_turn
+         << " rad in the step, above ContactStepOptions.max_correction_turn = " << options.max_correction_turn
+         << " (a far root of the linearised step, lambda_max = " << r.lambda_max << ");";
     if (!violating.empty())
       os << " " << violating.size() << " pair(s) below d_hat (1 - " << options.separation_margin
          << ") at the end, min d / d_hat = " << r.min_distance_ratio << " (bodies " << violating.front().i << ", "

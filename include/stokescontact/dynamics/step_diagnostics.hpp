@@ -26,6 +26,7 @@ struct StepDiagnostics {
   double wall_time_s = 0.0;            // the whole step
   double lambda_sum = 0.0;
   double lambda_max = 0.0;
+  double max_correction_turn = 0.0;    // the largest turn the contact correction gave a body, radians
 };
 
 }  // namespace stokescontact

@@ -340,6 +340,7 @@ class TimeStepper {
     if (!result.message.empty()) d.message = std::move(result.message);
     d.lambda_sum += result.lambda_sum;
     d.lambda_max = std::max(d.lambda_max, result.lambda_max);
+    d.max_correction_turn = std::max(d.max_correction_turn, result.max_correction_turn);
     return true;
   }
 

@@ -1,0 +1,148 @@
+// Far roots of the linearised contact step (eq. 13) on two crossing rods, and the guard that
+// refuses them: ContactStepOptions::max_correction_turn (contact/contact_step.hpp).
+//
+// Two rods (L = 4, R = 0.5, free draining) crossing at a small angle, a gap of ~2 d_hat,
+// pressed into each other by +-f across their axes with random torques: the trial step
+// overlaps deeply. Eq. 13 is linear in the rotation, so the end gap of the pair can reach
+// d_hat again far along the force: the default solver and the LCP sequence both find such a
+// root, lambda ~3000 (7-14x the push) with a correction that turns a rod by 1.1-1.7 rad and
+// leaves the pair 13-15 d_hat apart, or overlapping (the LCP sequence), instead of at d_hat.
+// Before the guard the default solver reported those steps converged. The cases were drawn at
+// random (theta in [0.02, 0.62] rad, offset along the lower rod in [-2, 2], gap in [1, 3]
+// d_hat, f in [100, 500], torques uniform in +-f/2): 350 of 3000 draws gave the default
+// solver a converged step turning a rod by more than 0.3 rad; these two are the clearest.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "stokescontact/contact/solvers/contact_solver.hpp"
+#include "stokescontact/dynamics/time_stepper.hpp"
+#include "stokescontact/mobility/free_draining.hpp"
+
+namespace crossing_rods_tests {
+
+namespace sc = stokescontact;
+
+namespace {
+
+const sc::Spherocylinder kRod{4.0, 0.5};
+constexpr double kDt = 0.01;
+constexpr double kDHat = 0.01;
+
+struct Crossing {
+  double theta;  // angle between the axes, radians
+  double shift;  // the upper rod's centre along the lower rod's axis
+  double gap;
+  double push;                    // +-push across the axes
+  std::array<double, 6> torques;  // of the lower, then the upper rod
+};
+
+const std::array<Crossing, 2> kCrossings{{
+    {0.15862556832129365, -0.040571916508695738, 0.018759502886215411, 432.31320527038827,
+     {-48.841442189236169, 45.348015336454012, 206.47794548828202, -171.54293815880769, 203.60249147153934,
+      -171.75908546108772}},
+    {0.25109555644153908, -0.013718888686470532, 0.023081885321589564, 250.14469397717531,
+     {9.3310516141692972, 29.228218062689852, -116.5056176186972, 123.3194148285735, -32.576853857615014,
+      60.833443036933787}},
+}};
+
+// The lower rod along x at the origin, the upper one turned by theta about y, above it.
+std::vector<sc::Pose> poses(const Crossing& c) {
+  const sc::Quat along_x(Eigen::AngleAxisd(0.5 * std::numbers::pi, sc::Vec3::UnitY()));
+  return {{sc::Vec3::Zero(), along_x},
+          {sc::Vec3(c.shift, 2.0 * kRod.radius + c.gap, 0.0),
+           sc::Quat(Eigen::AngleAxisd(c.theta, sc::Vec3::UnitY())) * along_x}};
+}
+
+sc::VecX forces(const Crossing& c) {
+  sc::VecX F = sc::VecX::Zero(12);
+  F(1) = c.push;
+  F(7) = -c.push;
+  for (int k = 0; k < 3; ++k) {
+    F(3 + k) = c.torques[static_cast<std::size_t>(k)];
+    F(9 + k) = c.torques[static_cast<std::size_t>(3 + k)];
+  }
+  return F;
+}
+
+}  // namespace
+
+// The far root is found, and reported as failed separation naming the option; the same step
+// with the guard lifted is the old "converged" answer, which the test shows is a far root.
+TEST(CrossingRods, FarRootIsNotReportedConverged) {
+  for (const Crossing& c : kCrossings) {
+    SCOPED_TRACE("theta " + std::to_string(c.theta));
+    const std::vector<sc::Pose> q = poses(c);
+    sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(kRod, 1.0), 2, 6);
+    mobility.set_configuration(q);
+    const sc::VecX U = mobility.apply(forces(c));
+    const std::vector<sc::Spherocylinder> shapes{kRod};
+    const sc::ContactStepProblem<sc::Spherocylinder> problem{shapes, q, U, kDt, kDHat, 0.0, 1.0, {}};
+
+    for (const char* name : {"default", "lcp-newton"}) {
+      SCOPED_TRACE(name);
+      const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, {}, sc::contact_solver_from_name(name));
+      EXPECT_EQ(r.status, sc::ContactStepStatus::failed_separation) << r.message;
+      EXPECT_GT(r.max_correction_turn, 1.0);
+      EXPECT_GT(r.lambda_max, 5.0 * c.push);
+      EXPECT_NE(r.message.find("ContactStepOptions.max_correction_turn"), std::string::npos) << r.message;
+    }
+
+    // Without the guard the default solver calls it converged: every end gap holds, but the
+    // pair ends more than 10 d_hat apart, pushed by 7x the force that pressed it.
+    sc::ContactStepOptions unguarded;
+    unguarded.max_correction_turn = 1e9;
+    const sc::ContactStepResult far = sc::solve_contact_step(problem, mobility, unguarded);
+    EXPECT_EQ(far.status, sc::ContactStepStatus::converged) << far.message;
+    EXPECT_GT(far.min_distance_ratio, 10.0);
+    EXPECT_GT(far.max_correction_turn, 1.0);
+
+#if STOKESCONTACT_HAS_NLOPT
+    // eq. 15 on the working set finds the near root: a turn of 0.19-0.28 rad, lambda 1.5-2.1 f.
+    const sc::ContactStepResult near =
+        sc::solve_contact_step(problem, mobility, {}, sc::contact_solver_from_name("barrier-working-set"));
+    EXPECT_EQ(near.status, sc::ContactStepStatus::converged) << near.message;
+    EXPECT_LT(near.max_correction_turn, 0.5);
+    EXPECT_LT(near.lambda_max, 3.0 * c.push);
+    EXPECT_GE(near.min_distance_ratio, 1.0 - 1e-3);
+#endif
+  }
+}
+
+// The time stepper sub-steps the refused step (two halves each) and commits it: every turn
+// within the bound, every gap at d_hat.
+TEST(CrossingRods, StepperSubStepsTheRefusedStep) {
+  for (const Crossing& c : kCrossings) {
+    SCOPED_TRACE("theta " + std::to_string(c.theta));
+    sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(kRod, 1.0), 2, 6);
+    sc::TimeStepperOptions o;
+    o.dt = kDt;
+    o.d_hat = kDHat;
+    sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({kRod}, poses(c), mobility, o);
+    stepper.set_external_forces(forces(c));
+    const sc::StepDiagnostics d = stepper.step();
+    EXPECT_EQ(d.status, sc::ContactStepStatus::converged) << d.message;
+    EXPECT_GE(d.substeps, 2u);
+    EXPECT_LE(d.max_correction_turn, o.contact_step.max_correction_turn);
+    EXPECT_GE(d.min_distance_ratio, 1.0 - 1e-3);
+  }
+}
+
+TEST(CrossingRods, NonPositiveTurnBoundIsRejected) {
+  for (const double bad : {0.0, -0.1}) {
+    sc::ContactStepOptions o;
+    o.max_correction_turn = bad;
+    try {
+      o.validate();
+      ADD_FAILURE() << "accepted max_correction_turn = " << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("ContactStepOptions.max_correction_turn"), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace crossing_rods_tests
