@@ -227,7 +227,7 @@ TEST(SegmentDistance, AlmostZeroLength) {
   expect_case({Vec3(0.5, 2, 0), Vec3(0.5 + 1e-13, 2, 0)}, {Vec3(0, 0, 0), Vec3(1, 0, 0)}, 2.0);
   // One whose squared length underflows is taken as a point (no 1 / 0 anywhere).
   const Segment tiny{Vec3(0.5, 2, 0), Vec3(0.5, 2, 1e-160)};
-  const sc::PieceClosestPoints c = sc::closest_points(tiny, {Vec3(0, 0, 0), Vec3(1, 0, 0)});
+  const sc::PieceClosestPoints c = sc::closest_points(tiny, Segment{Vec3(0, 0, 0), Vec3(1, 0, 0)});
   EXPECT_EQ(c.distance, 2.0);
   EXPECT_EQ(c.parameter_b, 0.5);
   EXPECT_EQ(sc::closest_points(Segment{Vec3(0, 0, 0), Vec3(1, 0, 0)}, tiny).distance, 2.0);
