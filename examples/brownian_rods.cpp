@@ -167,12 +167,18 @@ int run(const Options& o) {
               sc::json_number(r.applications_per_step) + ", \"iterations_per_step\": " +
               sc::json_number(r.iterations_per_step) + ", \"substeps_per_step\": " +
               sc::json_number(r.substeps_per_step) + ", \"min_d_over_d_hat\": " +
-              sc::json_number(r.min_distance_ratio) + ", \"wall_s\": " + sc::json_number(r.wall_s) +
+              sc::json_number(r.min_distance_ratio) + ", \"max_correction_turn\": " +
+              sc::json_number(r.max_correction_turn) + ", \"fallbacks\": " +
+              std::to_string(r.fallbacks) + ", \"wall_s\": " + sc::json_number(r.wall_s) +
               ", \"failure\": " + sc::json_quoted(r.failure) + "}");
     const std::string series = reference && u0 == 0.0 ? std::to_string(*reference).substr(0, 7) : "-";
     std::printf("%9.3g | %8.4f %8.4f | %9s | %7.2f %6.2f %6.2f | %9.6f | %7.4f | %8.1f%s\n", u0_scaled, ratio, error,
                 series.c_str(), r.pushed_per_step, r.applications_per_step, r.iterations_per_step,
                 r.min_distance_ratio, order, r.wall_s, converged ? "" : "  (error bar not converged)");
+    if (r.fallbacks > 0)
+      std::printf("          %ld contact sub-step(s) failed by the solver and solved again by another; largest "
+                  "correction turn %.3g rad\n",
+                  r.fallbacks, r.max_correction_turn);
     std::fflush(stdout);
     if (!r.failure.empty()) {
       std::printf("ERROR: U0 / (L D_R) = %g: %s\n", u0_scaled, r.failure.c_str());

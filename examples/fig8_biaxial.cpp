@@ -228,7 +228,7 @@ RunSummary run(const Options& o, const S& rod, double fraction, double dt, M& mo
                   ", \"wall_time_s\": " + sc::json_number(d.wall_time_s) + ", \"S\": " + sc::json_number(order) +
                   ", \"max_abs_x\": " + sc::json_number(max_x) + ", \"max_turn\": " + sc::json_number(max_turn) +
                   ", \"max_correction_turn\": " + sc::json_number(d.max_correction_turn) +
-                  ", \"substeps\": " + std::to_string(d.substeps) +
+                  ", \"substeps\": " + std::to_string(d.substeps) + ", \"fallbacks\": " + std::to_string(d.fallbacks) +
                   ", \"min_d_over_d_hat\": " + sc::json_number(d.min_distance_ratio) + ", \"status\": \"" +
                   std::string(sc::to_string(d.status)) + "\"}");
   }

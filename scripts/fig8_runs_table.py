@@ -8,8 +8,10 @@ fig8_biaxial's JSON lines, from a reference set of runs (BEFORE) and a new one (
 (files ending in .gz are read through gzip).
 
 Per run: steps done, min S, max turn of a rod (from the start), and for AFTER the largest
-contact-correction turn of a committed step and the sub-stepped steps (the step records'
-`max_correction_turn` and `substeps`, where the driver wrote them), and what stopped it.
+contact-correction turn of a committed step, the sub-stepped steps and the contact sub-steps
+another solver solved again after the default solver failed them (the step records'
+`max_correction_turn`, `substeps` and `fallbacks`, where the driver wrote them), and what
+stopped it.
 """
 import argparse
 import gzip
@@ -51,19 +53,20 @@ def main():
     before, after = runs(a.before), runs(a.after)
     print("| solver | directions | d_hat / R_rod | dt | steps done: before, after | min S: before, after "
           "| max turn (rad): before, after | max correction turn of a step, after | sub-stepped steps, after "
-          "| stopped: before, after |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+          "| sub-steps solved again, after | stopped: before, after |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for key in sorted(after):
         s1, steps = after[key]["summary"], after[key]["steps"]
         s0 = before.get(key, {}).get("summary")
         turn = max((r.get("max_correction_turn") or 0.0 for r in steps), default=0.0)
         substepped = sum(1 for r in steps if r.get("substeps", 1) > 1)
+        fallbacks = sum(r.get("fallbacks", 0) for r in steps)
 
         def pair(field, fmt):
             return (fmt.format(s0[field]) if s0 else "-") + ", " + fmt.format(s1[field])
 
         print(f"| {key[0]} | {key[1]} | {key[2]:g} | {key[3]:g} | {pair('steps', '{}')} | {pair('min_S', '{:.6f}')} "
-              f"| {pair('max_turn', '{:.2g}')} | {turn:.3g} | {substepped} "
+              f"| {pair('max_turn', '{:.2g}')} | {turn:.3g} | {substepped} | {fallbacks} "
               f"| {stopped(s0) if s0 else '-'}; {stopped(s1)} |")
 
 

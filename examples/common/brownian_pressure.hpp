@@ -5,7 +5,8 @@
 //     Z_step = 1 + sum over the step's contact sub-steps (h / dt) tr(sigma^col) / (3 N kT)
 // (Yan et al. eq. 16, 51-52; dynamics/collision_stress.hpp), block averaged for its error bar
 // (core/block_average.hpp). Also per step: pushed pairs (lambda > 0), mobility applications,
-// solver iterations and sub-steps, the smallest d / d_hat, and an optional extra observable
+// solver iterations and sub-steps, the smallest d / d_hat, the largest correction turn, the
+// sub-steps the default solver failed and another solved again (contact_solver.hpp), and an optional extra observable
 // per step (e.g. a nematic order parameter) averaged the same way. A step that throws ends
 // the run; its message is kept and the averages cover the steps before it.
 #include <stokescontact/stokescontact.hpp>
@@ -27,6 +28,8 @@ struct BrownianPressureRun {
   sc::BlockAverageResult extra;  // the extra observable (empty without one)
   double pushed_per_step = 0.0, applications_per_step = 0.0, iterations_per_step = 0.0, substeps_per_step = 0.0;
   double min_distance_ratio = std::numeric_limits<double>::quiet_NaN();  // NaN until a step is averaged
+  double max_correction_turn = 0.0;  // the largest turn a contact correction gave a body, averaged steps
+  long fallbacks = 0;                // contact sub-steps another solver solved again, all steps run
   double wall_s = 0.0;
   long steps = 0;  // averaged steps completed
   std::string failure;
@@ -51,6 +54,7 @@ BrownianPressureRun measure_brownian_pressure(sc::TimeStepper<S, M>& stepper, do
     for (long k = 0; k < equilibrate_steps + average_steps; ++k) {
       step_pressure = 0.0;
       const sc::StepDiagnostics d = stepper.step();
+      r.fallbacks += static_cast<long>(d.fallbacks);
       if (k < equilibrate_steps) continue;
       z.add(1.0 + step_pressure / (bodies * kT));
       if (extra) x.add(extra(std::span<const sc::Pose>(stepper.poses())));
@@ -58,6 +62,7 @@ BrownianPressureRun measure_brownian_pressure(sc::TimeStepper<S, M>& stepper, do
       r.applications_per_step += static_cast<double>(d.mobility_applications);
       r.iterations_per_step += static_cast<double>(d.iterations);
       r.substeps_per_step += static_cast<double>(d.substeps);
+      r.max_correction_turn = std::max(r.max_correction_turn, d.max_correction_turn);
       if (!(r.min_distance_ratio <= d.min_distance_ratio)) r.min_distance_ratio = d.min_distance_ratio;
       ++r.steps;
     }

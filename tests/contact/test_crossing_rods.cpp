@@ -69,27 +69,42 @@ sc::VecX forces(const Crossing& c) {
   return F;
 }
 
+// One crossing's contact step: the poses, the free-draining mobility set there, U = M F.
+struct CrossingStep {
+  std::vector<sc::Pose> q;
+  sc::FreeDrainingMobility mobility{sc::spherocylinder_mobility(kRod, 1.0), 2, 6};
+  sc::VecX U;
+  std::vector<sc::Spherocylinder> shapes{kRod};
+
+  explicit CrossingStep(const Crossing& c) : q(poses(c)) {
+    mobility.set_configuration(q);
+    U = mobility.apply(forces(c));
+  }
+  sc::ContactStepProblem<sc::Spherocylinder> problem() const { return {shapes, q, U, kDt, kDHat, 0.0, 1.0, {}}; }
+};
+
 }  // namespace
 
 // The far root is found, and reported as failed separation naming the option; the same step
 // with the guard lifted is the old "converged" answer, which the test shows is a far root.
 TEST(CrossingRods, FarRootIsNotReportedConverged) {
+  sc::DefectCorrectionOptions without_fallback;
+  without_fallback.far_root_fallback = false;
+  without_fallback.lcp_sequence_fallback = false;
   for (const Crossing& c : kCrossings) {
     SCOPED_TRACE("theta " + std::to_string(c.theta));
-    const std::vector<sc::Pose> q = poses(c);
-    sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(kRod, 1.0), 2, 6);
-    mobility.set_configuration(q);
-    const sc::VecX U = mobility.apply(forces(c));
-    const std::vector<sc::Spherocylinder> shapes{kRod};
-    const sc::ContactStepProblem<sc::Spherocylinder> problem{shapes, q, U, kDt, kDHat, 0.0, 1.0, {}};
+    CrossingStep setup(c);
+    sc::FreeDrainingMobility& mobility = setup.mobility;
+    const auto problem = setup.problem();
 
-    for (const char* name : {"default", "lcp-newton"}) {
-      SCOPED_TRACE(name);
-      const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, {}, sc::contact_solver_from_name(name));
+    for (const sc::ContactSolver& solver : {sc::ContactSolver{without_fallback}, sc::contact_solver_from_name("lcp-newton")}) {
+      SCOPED_TRACE(sc::contact_solver_name(solver));
+      const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, {}, solver);
       EXPECT_EQ(r.status, sc::ContactStepStatus::failed_separation) << r.message;
       EXPECT_GT(r.max_correction_turn, 1.0);
       EXPECT_GT(r.lambda_max, 5.0 * c.push);
       EXPECT_NE(r.message.find("ContactStepOptions.max_correction_turn"), std::string::npos) << r.message;
+      EXPECT_TRUE(r.fallback.empty()) << r.fallback;
     }
 
     // Without the guard the default solver calls it converged: every end gap holds, but the
@@ -100,18 +115,48 @@ TEST(CrossingRods, FarRootIsNotReportedConverged) {
     EXPECT_EQ(far.status, sc::ContactStepStatus::converged) << far.message;
     EXPECT_GT(far.min_distance_ratio, 10.0);
     EXPECT_GT(far.max_correction_turn, 1.0);
+    EXPECT_TRUE(far.fallback.empty()) << far.fallback;
+  }
+}
 
 #if STOKESCONTACT_HAS_NLOPT
-    // eq. 15 on the working set finds the near root: a turn of 0.19-0.28 rad, lambda 1.5-2.1 f.
+// eq. 15 on the working set finds the near root (a turn of 0.19-0.28 rad, lambda 1.5-2.1 f), and
+// the default solver falls back to it: the same answer, at the cost of both solves.
+TEST(CrossingRods, DefaultSolverFallsBackToTheNearRoot) {
+  for (const Crossing& c : kCrossings) {
+    SCOPED_TRACE("theta " + std::to_string(c.theta));
+    CrossingStep setup(c);
+    sc::FreeDrainingMobility& mobility = setup.mobility;
+    const auto problem = setup.problem();
+
     const sc::ContactStepResult near =
         sc::solve_contact_step(problem, mobility, {}, sc::contact_solver_from_name("barrier-working-set"));
     EXPECT_EQ(near.status, sc::ContactStepStatus::converged) << near.message;
     EXPECT_LT(near.max_correction_turn, 0.5);
     EXPECT_LT(near.lambda_max, 3.0 * c.push);
     EXPECT_GE(near.min_distance_ratio, 1.0 - 1e-3);
-#endif
+
+    const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility);
+    EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+    EXPECT_EQ(r.fallback, "barrier-working-set");
+    EXPECT_NE(r.message.find("barrier-working-set"), std::string::npos) << r.message;
+    EXPECT_EQ(r.lambda, near.lambda);
+    EXPECT_GE(r.iterations, near.iterations + 1);
+    EXPECT_LT(r.max_correction_turn, 0.5);
+
+    // In time: one contact step, no sub-step, and the diagnostics count the fallback.
+    sc::TimeStepperOptions o;
+    o.dt = kDt;
+    o.d_hat = kDHat;
+    sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({kRod}, setup.q, mobility, o);
+    stepper.set_external_forces(forces(c));
+    const sc::StepDiagnostics d = stepper.step();
+    EXPECT_EQ(d.status, sc::ContactStepStatus::converged) << d.message;
+    EXPECT_EQ(d.substeps, 1u);
+    EXPECT_EQ(d.fallbacks, 1u);
   }
 }
+#endif
 
 // The time stepper sub-steps the refused step (two halves each) and commits it: every turn
 // within the bound, every gap at d_hat.
@@ -122,7 +167,11 @@ TEST(CrossingRods, StepperSubStepsTheRefusedStep) {
     sc::TimeStepperOptions o;
     o.dt = kDt;
     o.d_hat = kDHat;
-    sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({kRod}, poses(c), mobility, o);
+    sc::DefectCorrectionOptions without_fallback;
+    without_fallback.far_root_fallback = false;
+    without_fallback.lcp_sequence_fallback = false;
+    sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({kRod}, poses(c), mobility,
+                                                                        sc::ContactSolver{without_fallback}, o);
     stepper.set_external_forces(forces(c));
     const sc::StepDiagnostics d = stepper.step();
     EXPECT_EQ(d.status, sc::ContactStepStatus::converged) << d.message;

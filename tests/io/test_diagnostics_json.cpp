@@ -38,12 +38,14 @@ TEST(DiagnosticsJson, EveryFieldInItsPlace) {
   d.lambda_sum = 12.5;
   d.lambda_max = 4.0;
   d.max_correction_turn = 0.125;
+  d.fallbacks = 1;
   EXPECT_EQ(sc::to_json(d),
             R"({"step": 12, "time": 0.25, "flagged_pairs": 7, "active_pairs": 3, "carried_pairs": 1, "substeps": 2, )"
             R"("min_distance_ratio": 1.0001, )"
             R"("status": "not_converged", "message": "stopped after 50 corrections", "iterations": 50, )"
             R"("unconstrained_applications": 1, "mobility_applications": 9, "wall_time_s": 0.5, )"
-            R"("lambda_sum": 12.5, "lambda_max": 4, "max_correction_turn": 0.125})");
+            R"("lambda_sum": 12.5, "lambda_max": 4, "max_correction_turn": 0.125, )"
+            R"("fallbacks": 1})");
 }
 
 TEST(DiagnosticsJson, StatusNamesAreTheContactStepsOwn) {

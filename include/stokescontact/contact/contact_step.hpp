@@ -221,6 +221,10 @@ struct ContactStepResult {
   int guarantee_rounds = 0;             // re-solves after adding missed pairs
   double max_correction_turn = 0.0;     // max over bodies of dt |omega| of M D lambda, radians
   Eigen::Index max_correction_turn_body = -1;  // the body that turns most (-1: none turns)
+  // The solver whose answer this is when the default solver failed the step and another one
+  // solved it again ("barrier-working-set", "lcp-newton"; solve_contact_step); empty otherwise.
+  // The work counted above is that of every solve.
+  std::string fallback;
 };
 
 // What a solver's core returns for one round: lambda and its own convergence.

@@ -27,6 +27,8 @@ struct StepDiagnostics {
   double lambda_sum = 0.0;
   double lambda_max = 0.0;
   double max_correction_turn = 0.0;    // the largest turn the contact correction gave a body, radians
+  std::size_t fallbacks = 0;           // contact sub-steps the default solver failed and another
+                                       // solver solved again (ContactStepResult::fallback)
 };
 
 }  // namespace stokescontact

@@ -341,6 +341,7 @@ class TimeStepper {
     d.lambda_sum += result.lambda_sum;
     d.lambda_max = std::max(d.lambda_max, result.lambda_max);
     d.max_correction_turn = std::max(d.max_correction_turn, result.max_correction_turn);
+    d.fallbacks += result.fallback.empty() ? 0 : 1;
     return true;
   }
 

@@ -25,7 +25,8 @@ inline std::string to_json(const StepDiagnostics& d) {
          ", \"mobility_applications\": " + std::to_string(d.mobility_applications) +
          ", \"wall_time_s\": " + json_number(d.wall_time_s) + ", \"lambda_sum\": " + json_number(d.lambda_sum) +
          ", \"lambda_max\": " + json_number(d.lambda_max) +
-         ", \"max_correction_turn\": " + json_number(d.max_correction_turn) + "}";
+         ", \"max_correction_turn\": " + json_number(d.max_correction_turn) +
+         ", \"fallbacks\": " + std::to_string(d.fallbacks) + "}";
 }
 
 }  // namespace stokescontact

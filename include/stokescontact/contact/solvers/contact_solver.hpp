@@ -3,7 +3,11 @@
 //
 // A `ContactSolver` is the options struct of one of the library's solvers; which alternative
 // it holds says which solver runs:
-//   DefectCorrectionOptions   the default: Broms eq. 27 by defect correction (defect_correction.hpp)
+//   DefectCorrectionOptions   the default: Broms eq. 27 by defect correction (defect_correction.hpp);
+//                             a step it fails is solved again: a far root (a turn above
+//                             ContactStepOptions::max_correction_turn) by barrier-working-set
+//                             where NLopt is there, then any failure by the LCP sequence
+//                             (solve_failed_step_again)
 //   LcpSequenceOptions        the NCP as a sequence of LCPs (Lu et al. Alg. 1; lcp_sequence.hpp)
 //   BarrierNloptOptions       the barrier method, Broms eq. 15 with NLopt (barrier_nlopt.hpp); only
 //                             where the library was configured with NLopt
@@ -18,6 +22,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -151,6 +156,78 @@ inline void set_stopping_tolerance(ContactSolver& solver, double tol) {
   std::visit([tol](auto& o) { o.tol = tol; }, solver);
 }
 
+namespace detail {
+
+// A message without its trailing separator.
+inline std::string trimmed(std::string message) {
+  while (!message.empty() && (message.back() == ';' || message.back() == ' ')) message.pop_back();
+  return message;
+}
+
+// A step the default solver failed (failed_separation) solved again by other solvers, in
+// order, the first answer that does not fail kept (DefectCorrectionOptions::far_root_fallback,
+// lcp_sequence_fallback):
+//  - a far root (a correction turning a body by more than ContactStepOptions::
+//    max_correction_turn) by eq. 15 on the working set (barrier-working-set, the same
+//    corrections and TOL; with NLopt). Eq. 13 is linear in the rotation, so a pair of crossing
+//    rods can have a near root and one far along the force that turns a rod by radians; the
+//    defect correction, which follows complementarity from the LCP of its model, can end at
+//    the far one, where the smallest sum of lambda finds the near one
+//    (tests/contact/test_crossing_rods.cpp);
+//  - any failure by the LCP sequence (lcp-newton: exact products, no probing, no ray search),
+//    whose LCPs hold contact networks where the corrections stall.
+// Each solve starts afresh (its probes cost again). The result counts the applications,
+// iterations and wall time of every solve; its `fallback` names the solver whose answer it is
+// (empty: every fallback failed too, and the default solver's failure is returned, with
+// theirs in its message).
+template <Shape S, MobilityOperator M>
+ContactStepResult solve_failed_step_again(const ContactStepProblem<S>& problem, M& mobility,
+                                          const ContactStepOptions& options, const DefectCorrectionOptions& solver,
+                                          ContactStepResult failed) {
+  std::size_t applications = failed.mobility_applications;
+  int iterations = failed.iterations;
+  double wall_time_s = failed.wall_time_s;
+  std::string tried;
+  const auto attempt = [&](std::string_view name, ContactStepResult again) -> std::optional<ContactStepResult> {
+    applications += again.mobility_applications;
+    iterations += again.iterations;
+    wall_time_s += again.wall_time_s;
+    if (again.status == ContactStepStatus::failed_separation) {
+      tried += "; " + std::string(name) + ", tried on this step: " + trimmed(again.message);
+      return std::nullopt;
+    }
+    again.mobility_applications = applications;
+    again.iterations = iterations;
+    again.wall_time_s = wall_time_s;
+    again.fallback = name;
+    again.message = "solved again by " + std::string(name) + " after the default solver's " + trimmed(failed.message) +
+                    (again.message.empty() ? std::string() : "; " + std::string(name) + ": " + again.message);
+    return again;
+  };
+#if STOKESCONTACT_HAS_NLOPT
+  if (solver.far_root_fallback && failed.max_correction_turn > options.max_correction_turn) {
+    BarrierNloptOptions working_set;
+    working_set.constraint = BarrierConstraint::working_set;
+    working_set.tol = solver.tol;
+    if (auto r = attempt("barrier-working-set", solve_contact_step_barrier(problem, mobility, options, working_set)))
+      return std::move(*r);
+  }
+#endif
+  if (solver.lcp_sequence_fallback) {
+    LcpSequenceOptions sequence;
+    sequence.inner = InnerLcpSolver::minimum_map_newton;
+    if (auto r = attempt("lcp-newton", solve_contact_step_lcp_sequence(problem, mobility, options, sequence)))
+      return std::move(*r);
+  }
+  failed.mobility_applications = applications;
+  failed.iterations = iterations;
+  failed.wall_time_s = wall_time_s;
+  failed.message = trimmed(failed.message) + tried;
+  return failed;
+}
+
+}  // namespace detail
+
 // One contact step by the chosen solver (by default the defect-correction solver). Bad input
 // throws std::invalid_argument naming the field before anything changes.
 template <Shape S, MobilityOperator M>
@@ -160,9 +237,12 @@ ContactStepResult solve_contact_step(const ContactStepProblem<S>& problem, M& mo
   return std::visit(
       [&](const auto& o) {
         using O = std::decay_t<decltype(o)>;
-        if constexpr (std::is_same_v<O, DefectCorrectionOptions>)
-          return solve_contact_step_defect_correction(problem, mobility, options, o);
-        else if constexpr (std::is_same_v<O, LcpSequenceOptions>)
+        if constexpr (std::is_same_v<O, DefectCorrectionOptions>) {
+          ContactStepResult r = solve_contact_step_defect_correction(problem, mobility, options, o);
+          if (r.status == ContactStepStatus::failed_separation && (o.far_root_fallback || o.lcp_sequence_fallback))
+            return detail::solve_failed_step_again(problem, mobility, options, o, std::move(r));
+          return r;
+        } else if constexpr (std::is_same_v<O, LcpSequenceOptions>)
           return solve_contact_step_lcp_sequence(problem, mobility, options, o);
 #if STOKESCONTACT_HAS_NLOPT
         else

@@ -44,7 +44,9 @@
 //    at convergence the ray (0, lambda*] is sampled for its first crossing of the target and a
 //    smaller crossing is refined by bisection and polished by one more round (never searched
 //    again); a round whose corrections stall is sent along its best ray, doubled until it
-//    separates, and then back to the first crossing the same way (ray_first_crossing).
+//    separates, and then back to the first crossing the same way (ray_first_crossing). That
+//    ray scales only the forces of the clusters (pairs linked through shared bodies) not yet
+//    separated; the separated clusters keep theirs (stalled_cluster_ray).
 //
 // Stopping rule (Broms eq. 29 form): at an iterate whose flagged pairs all have d >= d_hat, stop when
 // the next correction would change lambda by less than tol ||lambda||_inf; that iterate is
@@ -95,6 +97,14 @@ struct DefectCorrectionOptions {
   double contraction = 0.5;           // a correction must shrink the shortfall by this factor ...
                                       // ... or, twice in a row, the LCP sequence takes over
   LcpOptions lcp{1e-12};              // each small LCP's stopping rule
+  // A step this solver fails is solved again through solve_contact_step (contact_solver.hpp,
+  // solve_failed_step_again), the first answer that does not fail kept: a far root (its
+  // correction turns a body by more than ContactStepOptions::max_correction_turn) by eq. 15
+  // on the working set (barrier-working-set, which looks for the smallest sum of lambda and so
+  // for the near root; only where the library has NLopt), then any failure by the LCP
+  // sequence (lcp-newton). Both false: the failure is returned as is.
+  bool far_root_fallback = true;
+  bool lcp_sequence_fallback = true;
 
   void validate() const {
     require_non_negative(margin, "DefectCorrectionOptions.margin");
@@ -197,15 +207,28 @@ double min_flagged_distance_at(const ContactStep<S, M>& step, const VecX& MD_lam
   return step.measure(MD_lambda).min_distance();
 }
 
-// The first crossing of the target by the flagged distances on the ray s lambda, s in (0, s_max],
-// given M D lambda (so every sample is free, M D linear in lambda): the smallest of `samples`
-// equal steps whose min d >= target, refined by bisection against the step before it to a
-// relative width `tol`; the returned s separates. None when no sample separates. A separated
-// window narrower than one step can be missed: the samples bound the cost.
+// A ray of forces lambda(s) = base + s direction, s > 0, with M D of both (so every point
+// of it is free, M D linear in lambda). The whole iterate is the ray with base 0; a stalled
+// cluster's is its own forces scaled with the others' held (stalled_cluster_ray).
+struct ForceRay {
+  VecX base, direction;        // lambda
+  VecX MD_base, MD_direction;  // M D lambda
+
+  VecX lambda(double s) const { return base + s * direction; }
+  VecX MD(double s) const { return MD_base + s * MD_direction; }
+  static ForceRay through(const VecX& lambda, const VecX& MD_lambda) {
+    return {VecX::Zero(lambda.size()), lambda, VecX::Zero(MD_lambda.size()), MD_lambda};
+  }
+};
+
+// The first crossing of the target by the flagged distances on the ray, s in (0, s_max]: the
+// smallest of `samples` equal steps whose min d >= target, refined by bisection against the
+// step before it to a relative width `tol`; the returned s separates. None when no sample
+// separates. A separated window narrower than one step can be missed: the samples bound the cost.
 template <Shape S, MobilityOperator M>
-std::optional<double> ray_first_crossing(const ContactStep<S, M>& step, const VecX& MD_lambda, double s_max,
+std::optional<double> ray_first_crossing(const ContactStep<S, M>& step, const ForceRay& ray, double s_max,
                                          double target, int samples, double tol) {
-  const auto separated = [&](double s) { return min_flagged_distance_at(step, s * MD_lambda) >= target; };
+  const auto separated = [&](double s) { return min_flagged_distance_at(step, ray.MD(s)) >= target; };
   double lo = 0.0, hi = -1.0;
   for (int j = 1; j <= samples; ++j) {
     const double s = s_max * j / samples;
@@ -221,6 +244,51 @@ std::optional<double> ray_first_crossing(const ContactStep<S, M>& step, const Ve
     (separated(mid) ? hi : lo) = mid;
   }
   return hi;
+}
+
+// The pairs of the working set (pushed, or below `target`) in clusters, pairs linked through
+// shared bodies transitively, that hold a pair below `target`: the clusters not yet
+// separated. With a local mobility (free draining) no force outside a cluster moves its bodies.
+template <Shape S, MobilityOperator M>
+std::vector<char> unseparated_clusters(const ContactStep<S, M>& step, const VecX& lambda, const VecX& distances,
+                                       double target) {
+  const std::vector<ContactPair>& pairs = step.pairs();
+  std::vector<Eigen::Index> parent(step.problem().poses.size());
+  for (std::size_t b = 0; b < parent.size(); ++b) parent[b] = static_cast<Eigen::Index>(b);
+  const auto root = [&](Eigen::Index b) {
+    while (parent[static_cast<std::size_t>(b)] != b)
+      b = parent[static_cast<std::size_t>(b)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(b)])];
+    return b;
+  };
+  const auto pair = [&](Eigen::Index k) -> const ContactPair& { return pairs[static_cast<std::size_t>(k)]; };
+  const auto in_working_set = [&](Eigen::Index k) { return lambda(k) > 0.0 || distances(k) < target; };
+  for (Eigen::Index k = 0; k < step.nc(); ++k)
+    if (in_working_set(k)) parent[static_cast<std::size_t>(root(pair(k).i))] = root(pair(k).j);
+  std::vector<char> short_root(parent.size(), 0);
+  for (Eigen::Index k = 0; k < step.nc(); ++k)
+    if (distances(k) < target) short_root[static_cast<std::size_t>(root(pair(k).i))] = 1;
+  std::vector<char> member(static_cast<std::size_t>(step.nc()), 0);
+  for (Eigen::Index k = 0; k < step.nc(); ++k)
+    member[static_cast<std::size_t>(k)] = in_working_set(k) && short_root[static_cast<std::size_t>(root(pair(k).i))];
+  return member;
+}
+
+// The ray of a round whose corrections stall: the forces of the clusters not yet separated at
+// the best iterate scaled, every separated cluster's held. Scaling the whole iterate instead
+// pushes clusters that had converged as far as the stalled one needs (measured: 1000 Brownian
+// rods, where one stalled pair of crossing rods sent the pushed pairs of the step to forces of
+// up to 6e5, a far root turning a rod by 1400 rad). One application for M D of the scaled
+// forces, where that is not free; none when they are all the forces.
+template <Shape S, MobilityOperator M>
+ForceRay stalled_cluster_ray(ContactStep<S, M>& step, const VecX& lambda, const VecX& MD_lambda,
+                             const VecX& distances, double target) {
+  const std::vector<char> member = unseparated_clusters(step, lambda, distances, target);
+  VecX direction = lambda;
+  for (Eigen::Index k = 0; k < lambda.size(); ++k)
+    if (!member[static_cast<std::size_t>(k)]) direction(k) = 0.0;
+  if (direction.sum() == 0.0 || direction == lambda) return ForceRay::through(lambda, MD_lambda);
+  VecX MD_direction = step.MD_times(direction);
+  return {lambda - direction, direction, MD_lambda - MD_direction, std::move(MD_direction)};
 }
 
 // The fallback of a round whose corrections do not contract.
@@ -243,14 +311,14 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
                                                   const DefectCorrectionOptions& options, const Subproblem& subproblem,
                                                   bool search_rays = true);
 
-// The round again from s lambda, the first crossing of the ray found by ray_first_crossing
-// (no further ray search): its result when it separates with no more total force, else s
-// lambda itself, which separates. `before`: the corrections spent so far.
+// The round again from lambda(s) of the ray, its first crossing found by ray_first_crossing
+// (no further ray search): its result when it separates with no more total force, else
+// lambda(s) itself, which separates. `before`: the corrections spent so far.
 template <Shape S, MobilityOperator M, class Subproblem>
-ContactSolveOutcome restart_from_crossing(ContactStep<S, M>& step, const VecX& lambda, double s, int before,
+ContactSolveOutcome restart_from_crossing(ContactStep<S, M>& step, const ForceRay& ray, double s, int before,
                                           const DefectCorrectionOptions& options, const Subproblem& subproblem,
                                           const std::string& why) {
-  const VecX start = s * lambda;
+  const VecX start = ray.lambda(s);
   ContactSolveOutcome out = solve_defect_correction_round(step, start, options, subproblem, false);
   const bool kept = out.converged && step.evaluate(out.lambda).min_distance() >= step.problem().d_hat &&
                     out.lambda.sum() <= start.sum();
@@ -259,8 +327,9 @@ ContactSolveOutcome restart_from_crossing(ContactStep<S, M>& step, const VecX& l
     out.converged = true;  // separated (the crossing), no force beyond the ray's smallest
   }
   out.iterations += before;
-  out.message = std::string(subproblem.name) + ": " + why + ", first crossing of d_hat at " + std::to_string(s) + " x lambda" +
-                (kept ? ", polished" : "");
+  const bool whole = ray.base.isZero(0.0);
+  out.message = std::string(subproblem.name) + ": " + why + ", first crossing of d_hat at " + std::to_string(s) + " x " +
+                (whole ? "lambda" : "the unseparated clusters' lambda") + (kept ? ", polished" : "");
   return out;
 }
 
@@ -289,7 +358,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
   Eigen::SparseMatrix<double> probed;  // positive_definite(probing.matrix()), recomputed when W grows
   double previous_shortfall = std::numeric_limits<double>::infinity();
   double best_shortfall = std::numeric_limits<double>::infinity();
-  VecX best_lambda = lambda, best_MD;  // best_MD: M D best_lambda
+  VecX best_lambda = lambda, best_MD, best_distances;  // best_MD: M D best_lambda
   int slow_corrections = 0;
   for (;;) {
     const ContactEvaluation& e = step.evaluate(lambda);
@@ -314,23 +383,26 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       best_shortfall = shortfall;
       best_lambda = lambda;
       best_MD = e.MD_lambda;
+      best_distances = e.distances;
     }
     // (With every probe a single contact the model is exact, and slowness is the geometry's.)
     const bool shared_probes = std::isfinite(radius) && probing.probes() < static_cast<int>(probing.members().size());
     slow_corrections = shared_probes && shortfall > options.contraction * previous_shortfall ? slow_corrections + 1 : 0;
     if (slow_corrections == 2) return finish_by_lcp_sequence(step, best_lambda, out.iterations, options, subproblem.name);
     // Corrections that stall with exact single-contact probes: the linear model points the
-    // wrong way (d falls along the force before it rises, non-convex contacts). The best ray is
-    // doubled until it separates (free, see above), then searched back for its first crossing.
+    // wrong way (d falls along the force before it rises, non-convex contacts). The best
+    // iterate's ray through the clusters not yet separated (stalled_cluster_ray) is doubled until it
+    // separates (free, see above), then searched back for its first crossing.
     stalled = !shared_probes && out.iterations > 0 && shortfall > options.contraction * previous_shortfall
                   ? stalled + 1 : 0;
     if (search_rays && stalled == options.stall_corrections && best_lambda.sum() > 0.0) {
-      const VecX& MD_best = best_MD;  // (evaluating best_lambda again would overwrite e)
+      // (evaluating best_lambda again would overwrite e: its M D and distances were kept)
+      const ForceRay ray = stalled_cluster_ray(step, best_lambda, best_MD, best_distances, target);
       for (double s_max = 2.0; s_max <= 1024.0; s_max *= 2.0)
-        if (min_flagged_distance_at(step, s_max * MD_best) >= target) {
+        if (min_flagged_distance_at(step, ray.MD(s_max)) >= target) {
           if (const std::optional<double> s =
-                  ray_first_crossing(step, MD_best, s_max, target, 2 * options.ray_samples, ray_tol))
-            return restart_from_crossing(step, best_lambda, *s, out.iterations, options, subproblem,
+                  ray_first_crossing(step, ray, s_max, target, 2 * options.ray_samples, ray_tol))
+            return restart_from_crossing(step, ray, *s, out.iterations, options, subproblem,
                                          "corrections stalled " + std::to_string(stalled) + " times");
           break;
         }
@@ -370,10 +442,11 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       // costs them and nothing else (no bisection towards s = 1, whose crossing is lambda's).
       if (search_rays && lambda.sum() > 0.0) {
         const int below_one = options.ray_samples - 1;
-        const std::optional<double> s = ray_first_crossing(step, e.MD_lambda, double(below_one) / options.ray_samples,
-                                                           target, below_one, ray_tol);
+        const ForceRay ray = ForceRay::through(lambda, e.MD_lambda);
+        const std::optional<double> s =
+            ray_first_crossing(step, ray, double(below_one) / options.ray_samples, target, below_one, ray_tol);
         if (s && *s < 1.0 - 1.0 / options.ray_samples)
-          return restart_from_crossing(step, lambda, *s, out.iterations, options, subproblem, "converged to a far root");
+          return restart_from_crossing(step, ray, *s, out.iterations, options, subproblem, "converged to a far root");
       }
       out.converged = true;
       break;
