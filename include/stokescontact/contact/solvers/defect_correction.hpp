@@ -275,9 +275,9 @@ std::vector<char> unseparated_clusters(const ContactStep<S, M>& step, const VecX
 
 // The ray of a round whose corrections stall: the forces of the clusters not yet separated at
 // the best iterate scaled, every separated cluster's held. Scaling the whole iterate instead
-// pushes clusters that had converged as far as the stalled one needs (measured: 1000 Brownian
-// rods, where one stalled pair of crossing rods sent the pushed pairs of the step to forces of
-// up to 6e5, a far root turning a rod by 1400 rad). One application for M D of the scaled
+// pushes clusters that had converged as far as the stalled one needs, by up to 1024 (1000
+// Brownian rods: a step whose default answer had lambda_max 6e5 and turned a rod by 1400 rad
+// passed once the ray was limited so; docs/results.md). One application for M D of the scaled
 // forces, where that is not free; none when they are all the forces.
 template <Shape S, MobilityOperator M>
 ForceRay stalled_cluster_ray(ContactStep<S, M>& step, const VecX& lambda, const VecX& MD_lambda,
