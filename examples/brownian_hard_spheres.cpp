@@ -90,33 +90,6 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// Z measured at one step size: sqrt(dt), the mean and its error bar.
-struct ZAtStep {
-  double sqrt_dt = 0.0, z = 0.0, error = 0.0;
-};
-
-struct Extrapolated {
-  double z = 0.0, error = 0.0, slope = 0.0;
-};
-
-// Weighted least squares Z = z + slope sqrt(dt), weights 1 / error^2 (equal weights if an
-// error bar is 0); the error of z from the inverse normal matrix.
-Extrapolated extrapolate_to_zero_step(const std::vector<ZAtStep>& points) {
-  bool all_errors = true;
-  for (const ZAtStep& p : points) all_errors = all_errors && p.error > 0.0;
-  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
-  for (const ZAtStep& p : points) {
-    const double w = all_errors ? 1.0 / (p.error * p.error) : 1.0;
-    const Eigen::Vector2d row(1.0, p.sqrt_dt);
-    normal += w * row * row.transpose();
-    rhs += w * p.z * row;
-  }
-  const Eigen::Matrix2d covariance = normal.inverse();
-  const Eigen::Vector2d fit = covariance * rhs;
-  return {fit(0), all_errors ? std::sqrt(covariance(0, 0)) : 0.0, fit(1)};
-}
-
 bool within_tolerance(const Options& o, double phi, double dt, const std::string& solver, double z, double error,
                       double z_cs) {
   if (std::abs(z - z_cs) <= o.tolerance * z_cs + 3.0 * error) return true;
@@ -161,7 +134,7 @@ int run(const Options& o) {
   bool ok = true;
   for (const double phi : o.phis)
     for (const std::string& solver : o.solvers) {
-      std::vector<ZAtStep> measured_z;
+      std::vector<ex::ZAtStep> measured_z;
       for (const double dt : o.dts) {
         const ex::BrownianPressureRun r = run_one(o, phi, dt, solver);
         const double eta = phi * std::pow(1.0 + 0.5 * o.d_hat, 3);  // diameter 2a + d_hat, a = 1
@@ -198,7 +171,7 @@ int run(const Options& o) {
       }
       if (o.dts.size() < 2 || measured_z.size() != o.dts.size()) continue;
       const double z_cs = carnahan_starling(phi * std::pow(1.0 + 0.5 * o.d_hat, 3));  // as above
-      const Extrapolated z0 = extrapolate_to_zero_step(measured_z);
+      const ex::Extrapolated z0 = ex::extrapolate_to_zero_step(measured_z);
       sink.line("{\"N\": " + std::to_string(o.n) + ", \"phi\": " + sc::json_number(phi) + ", \"dt\": 0, \"extrapolated\": true" +
                 ", \"solver\": \"" + solver + "\", \"Z\": " + sc::json_number(z0.z) + ", \"Z_error\": " +
                 sc::json_number(z0.error) + ", \"slope_sqrt_dt\": " + sc::json_number(z0.slope) + ", \"Z_CS\": " +

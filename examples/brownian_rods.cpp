@@ -1,34 +1,55 @@
-// Brownian and self-propelled spherocylinders in the dilute limit (Yan, Zhang & Shelley 2019
-// Sec. IV-V.A, Fig. 6): N rods of diameter D = 1 and cylinder length L = aspect D in a
+// Brownian and self-propelled spherocylinders (Yan, Zhang & Shelley 2019 Sec. IV-V.A, Fig.
+// 3-6): N rods of diameter D = 1 and cylinder length L = aspect D in a
 // periodic cube at packing fraction phi, free draining with Yan's slender-body mobility
 // (eq. 45-50, mobility/free_draining.hpp spherocylinder_mobility; viscosity 1, kT = 1), each
 // rod propelled at speed U0 along its axis n (a force U0 zeta_par n, so that M F = U0 n), the
 // default contact solver holding every gap at >= d_hat each step.
 //
-//   brownian_rods [--aspect 5] [--phi 0.02] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3] [--d-hat 1e-2]
-//                 [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1] [--tolerance 0]
+//   brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]
+//                 [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]
+//                 [--directions particle|surface|overlap-ends] [--start random|aligned] [--melt 0]
+//                 [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]
 //                 [--output FILE]
 //
 // --u0 is given as U0 / (L D_R), the paper's Fig. 6 axis (D_R = kT / zeta_r, eq. 49); --dt,
-// --equilibrate and --average are in rotational times 1 / D_R. Start: periodic_random_placement
-// of the seed (every gap > d_hat). Per U0, the collision pressure is reported as Yan's
+// --equilibrate, --average, --melt and --melt-dt are in rotational times 1 / D_R. --eta gives
+// the packing fraction of the hard core D + d_hat instead of phi (that of diameter D).
+// Start: --start random, periodic_random_placement of the seed (every gap > d_hat; phi < 0.3);
+// --start aligned, periodic_aligned_columns (every rod along z, Yan et al. Sec. IV.B's aligned
+// start, for dense suspensions), then --melt time units of Brownian motion at --melt-dt
+// without propulsion, unrecorded, whose end is the start of every run (the summary prints its
+// nematic order; --progress K writes every K-th melt step's diagnostics to stderr as JSON).
+// Every (U0, dt) runs from that start; given several --dt, a row "dt -> 0" per U0
+// extrapolates Z = Z_0 + c sqrt(dt) (brownian_pressure.hpp). --directions: the contact
+// directions (overlap-ends holds near-parallel rods at both ends of their overlap);
+// --max-substep-halvings: TimeStepperOptions::max_substep_halvings (0: a step the solver
+// fails ends the run at once, with the solver's message). Per run, the collision pressure is
+// reported as Yan's
 //     Pi^col / (B2 n kT) = (Z - 1) / (B2 n),   B2 = pi (2 D'^3 / 3 + L D'^2 + L^2 D' / 4),
 // (eq. 53-55; B2 of hard spherocylinders, exact, Onsager 1949) with the hard-core diameter
 // D' = D + d_hat that the contact step holds (phi and n count the rods of diameter D), with
-// the error bar of Z's block
-// average, and the nematic order parameter S (largest eigenvalue of <3 n n^T - I> / 2) as a
-// check that the suspension stays isotropic (S ~ 1 / sqrt(N) there). In the dilute limit and at
+// the error bar of Z's block average, and the nematic order parameter S (largest eigenvalue
+// of <3 n n^T - I> / 2), which is ~ 1 / sqrt(N) in an isotropic suspension. In the dilute limit and at
 // U0 = 0 the ratio tends to 1 + (B3 / B2^2) (B2 n) + (B4 / B2^3) (B2 n)^2 + ...; the driver
 // prints that truncated series with B3 / B2^2 and B4 / B2^3 for L / D = 5 (the only aspect it
 // has them for) from Monte Carlo virial coefficients (see docs/results.md for the source).
+// Dense suspensions of L / D = 5 at U0 = 0 are compared with the isotropic Monte Carlo
+// equation of state of McGrother, Williamson & Jackson, J. Chem. Phys. 104, 6755 (1996),
+// Table V (Z = P v / (eta kT) at their packing fractions eta, printed where the hard-core eta
+// is within 5e-4 of one). Also per run: the collision stress along the nematic director n of
+// the run's last step and across it, Z_par = 1 + n . Sigma^col n / (N kT) and Z_perp (the
+// mean of the other two directions; Z = (Z_par + 2 Z_perp) / 3), the stress anisotropy of Yan
+// et al. Sec. IV.B.
 // --tolerance > 0: ERROR when the U0 = 0 ratio is not within tolerance (relative) plus 3 error
 // bars of that series.
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
 #include <stokescontact/stokescontact.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <memory>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -37,6 +58,7 @@
 
 #include "common/brownian_pressure.hpp"
 #include "common/cli.hpp"
+#include "common/rod_experiment.hpp"
 
 namespace sc = stokescontact;
 namespace ex = examples;
@@ -44,17 +66,25 @@ namespace ex = examples;
 namespace {
 
 constexpr const char* kUsage =
-    "usage: brownian_rods [--aspect 5] [--phi 0.02] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3] [--d-hat 1e-2]\n"
-    "                     [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1] [--tolerance 0]\n"
+    "usage: brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]\n"
+    "                     [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]\n"
+    "                     [--directions particle|surface|overlap-ends] [--start random|aligned] [--melt 0]\n"
+    "                     [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]\n"
     "                     [--output FILE]\n";
 
 struct Options {
   double aspect = 5.0;
   double phi = 0.02;
+  std::optional<double> eta;  // of the hard core D + d_hat; sets phi when given
   std::size_t n = 1000;
-  std::vector<double> u0;
-  double dt = 1e-3, d_hat = 1e-2, equilibrate = 0.5, average = 2.0;
+  std::vector<double> u0, dts;
+  double d_hat = 1e-2, equilibrate = 0.5, average = 2.0;
+  std::string start = "random";
+  double melt = 0.0, melt_dt = 1e-3;
+  long progress = 0;  // melt steps between diagnostics lines on stderr (0: none)
+  int halvings = 4;   // TimeStepperOptions::max_substep_halvings
   std::string solver = "default";
+  ex::RodDirections directions = ex::RodDirections::particle;
   std::uint64_t seed = 1;
   double tolerance = 0.0;
   std::string output;
@@ -65,16 +95,30 @@ Options parse(int argc, char** argv) {
   Options o;
   o.aspect = args.number("--aspect", 5.0, 0.0);
   if (!(o.aspect > 0.0)) throw std::invalid_argument("--aspect must be > 0");
+  o.eta = args.positive("--eta");
+  if (o.eta && args.text("--phi", "") != "") throw std::invalid_argument("give --phi or --eta, not both");
   o.phi = args.number("--phi", 0.02, 0.0);
-  if (!(o.phi > 0.0 && o.phi < 0.3)) throw std::invalid_argument("--phi must lie in (0, 0.3)");
   o.n = static_cast<std::size_t>(args.integer("--n", 1000, 2));
   o.u0 = args.numbers("--u0", {0.0, 1.0, 2.0, 4.0}, 0.0);
-  o.dt = args.number("--dt", 1e-3, 0.0);
+  o.dts = args.numbers("--dt", {1e-3}, 0.0);
   o.d_hat = args.number("--d-hat", 1e-2, 0.0);
   o.equilibrate = args.number("--equilibrate", 0.5, 0.0);
   o.average = args.number("--average", 2.0, 0.0);
-  for (const double* v : {&o.dt, &o.d_hat, &o.average})
-    if (!(*v > 0.0)) throw std::invalid_argument("--dt, --d-hat and --average must be > 0");
+  for (const double* v : {&o.d_hat, &o.average})
+    if (!(*v > 0.0)) throw std::invalid_argument("--d-hat and --average must be > 0");
+  for (const double dt : o.dts)
+    if (!(dt > 0.0)) throw std::invalid_argument("--dt must be > 0");
+  o.directions = ex::parse_directions(args.text("--directions", "particle"));
+  if (o.directions == ex::RodDirections::line)
+    throw std::invalid_argument("--directions line needs line-contact rods; use particle, surface or overlap-ends");
+  o.start = args.text("--start", "random");
+  if (o.start != "random" && o.start != "aligned")
+    throw std::invalid_argument("--start must be random or aligned, got '" + o.start + "'");
+  o.melt = args.number("--melt", 0.0, 0.0);
+  o.melt_dt = args.number("--melt-dt", 1e-3, 0.0);
+  if (!(o.melt_dt > 0.0)) throw std::invalid_argument("--melt-dt must be > 0");
+  o.progress = static_cast<long>(args.integer("--progress", 0, 0));
+  o.halvings = static_cast<int>(args.integer("--max-substep-halvings", 4, 0));
   o.solver = args.text("--solver", "default");
   sc::contact_solver_from_name(o.solver);
   o.seed = static_cast<std::uint64_t>(args.integer("--seed", 1, 0));
@@ -84,15 +128,23 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// Nematic order parameter: the largest eigenvalue of Q = <3 n n^T - I> / 2 over the rods.
-double nematic_order(std::span<const sc::Pose> poses) {
+// The order tensor Q = <3 n n^T - I> / 2 over the rods (n the axis, body z); the nematic order
+// parameter S is its largest eigenvalue, the director that eigenvalue's eigenvector.
+sc::Mat3 order_tensor(std::span<const sc::Pose> poses) {
   sc::Mat3 q = sc::Mat3::Zero();
   for (const sc::Pose& p : poses) {
-    const sc::Vec3 n = p.rotation().col(2);  // the rod axis, body z
+    const sc::Vec3 n = p.rotation().col(2);
     q += 1.5 * n * n.transpose() - 0.5 * sc::Mat3::Identity();
   }
-  q /= static_cast<double>(poses.size());
-  return Eigen::SelfAdjointEigenSolver<sc::Mat3>(q).eigenvalues().maxCoeff();
+  return q / static_cast<double>(poses.size());
+}
+
+double nematic_order(std::span<const sc::Pose> poses) {
+  return Eigen::SelfAdjointEigenSolver<sc::Mat3>(order_tensor(poses)).eigenvalues().maxCoeff();
+}
+
+sc::Vec3 director(std::span<const sc::Pose> poses) {
+  return Eigen::SelfAdjointEigenSolver<sc::Mat3>(order_tensor(poses)).eigenvectors().col(2);  // ascending
 }
 
 // Truncated virial series of (Z - 1) / (B2 n) at U0 = 0 for L / D = 5 (docs/results.md names
@@ -102,93 +154,184 @@ std::optional<double> virial_ratio(double aspect, double b2n) {
   return 1.0 + 0.41946 * b2n + 0.05275 * b2n * b2n;
 }
 
+// McGrother, Williamson & Jackson, J. Chem. Phys. 104, 6755 (1996), Table V, L / D = 5: the
+// isotropic branch (nematic order <= 0.17) of their NPT Monte Carlo, P v / kT at packing
+// fraction eta (v the rod's volume), as reproduced in the public repository
+// Allen-Tildesley/examples (python_examples/GUIDE.md). Z = P v / (eta kT).
+struct MonteCarloPoint {
+  double eta, pv;
+};
+constexpr MonteCarloPoint kMcGrother[] = {{0.310, 2.53}, {0.352, 3.63}, {0.397, 4.89}, {0.400, 5.05}};
+
+std::optional<double> mcgrother_z(double aspect, double eta) {
+  if (std::abs(aspect - 5.0) > 1e-12) return std::nullopt;
+  for (const MonteCarloPoint& p : kMcGrother)
+    if (std::abs(eta - p.eta) <= 5e-4) return p.pv / p.eta;
+  return std::nullopt;
+}
+
+struct System {
+  sc::Spherocylinder rod;
+  sc::Mat6 body_mobility;
+  double D_R = 0.0, m_par = 0.0, side = 0.0;
+};
+
+using RodStepper = sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility>;
+
+// A Brownian stepper from `start` at step dt_D_R / D_R, each rod propelled at u0 along its axis.
+std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, const std::vector<sc::Pose>& start,
+                                         double dt_D_R, double u0, sc::FreeDrainingMobility& mobility) {
+  sc::TimeStepperOptions options;
+  options.dt = dt_D_R / s.D_R;
+  options.d_hat = o.d_hat;
+  options.box = sc::PeriodicBox{sc::Vec3::Constant(s.side)};
+  options.contact_step.directions = ex::contact_directions(o.directions);
+  options.max_substep_halvings = o.halvings;
+  options.brownian.emplace();
+  options.brownian->kT = 1.0;
+  options.brownian->seed = o.seed;
+  auto stepper = std::make_unique<RodStepper>(std::vector<sc::Spherocylinder>{s.rod}, start, mobility,
+                                              sc::contact_solver_from_name(o.solver), options);
+  if (u0 > 0.0)  // self-propulsion: M F = U0 n for the force U0 zeta_par n (no torque)
+    stepper->set_external_force_field([u0, m_par = s.m_par](double, std::span<const sc::Pose> poses) {
+      sc::VecX F = sc::VecX::Zero(6 * static_cast<Eigen::Index>(poses.size()));
+      for (std::size_t i = 0; i < poses.size(); ++i)
+        F.segment<3>(6 * static_cast<Eigen::Index>(i)) = (u0 / m_par) * poses[i].rotation().col(2);
+      return F;
+    });
+  return stepper;
+}
+
 int run(const Options& o) {
   constexpr double kT = 1.0, viscosity = 1.0, D = 1.0;
   const double L = o.aspect * D;
-  const sc::Spherocylinder rod{L, 0.5 * D};
-  const sc::Mat6 body_mobility = sc::spherocylinder_mobility(rod, viscosity);
-  const double D_R = kT * body_mobility(3, 3);  // 1 / zeta_r (eq. 49)
-  const double m_par = body_mobility(2, 2);     // 1 / zeta_par (eq. 47), axis = body z
-  const double v0 = std::numbers::pi * (0.25 * L * D * D + D * D * D / 6.0);
+  System s{sc::Spherocylinder{L, 0.5 * D}, {}, 0.0, 0.0, 0.0};
+  s.body_mobility = sc::spherocylinder_mobility(s.rod, viscosity);
+  s.D_R = kT * s.body_mobility(3, 3);  // 1 / zeta_r (eq. 49)
+  s.m_par = s.body_mobility(2, 2);     // 1 / zeta_par (eq. 47), axis = body z
+  const auto rod_volume = [L](double d) { return std::numbers::pi * (0.25 * L * d * d + d * d * d / 6.0); };
   const double Dh = D + o.d_hat;  // the hard core the contact step holds
+  const double phi = o.eta ? *o.eta * rod_volume(D) / rod_volume(Dh) : o.phi;
+  if (!(phi > 0.0 && phi < (o.start == "random" ? 0.3 : 0.74)))
+    throw std::invalid_argument(std::string(o.eta ? "--eta gives phi = " : "--phi = ") + std::to_string(phi) +
+                                (o.start == "random" ? ": phi must lie in (0, 0.3) with --start random (denser: --start aligned)"
+                                                     : ": phi must lie in (0, 0.74)"));
+  s.side = std::cbrt(static_cast<double>(o.n) * rod_volume(D) / phi);
+  const double number_density = static_cast<double>(o.n) / (s.side * s.side * s.side);
+  const double eta = number_density * rod_volume(Dh);
   const double b2 = std::numbers::pi * (2.0 * Dh * Dh * Dh / 3.0 + L * Dh * Dh + 0.25 * L * L * Dh);
-  const double side = std::cbrt(static_cast<double>(o.n) * v0 / o.phi);
-  const double number_density = static_cast<double>(o.n) / (side * side * side);
   const double b2n = b2 * number_density;
   const std::optional<double> reference = virial_ratio(o.aspect, b2n);
-  const double dt = o.dt / D_R;
+  const std::optional<double> monte_carlo = mcgrother_z(o.aspect, eta);
   ex::JsonLines sink(o.output);
-  std::printf("Brownian rods: N = %zu spherocylinders L/D = %g in a periodic cube of side %.4g, phi %g, B2 n = %.5f,\n"
-              "free draining (Yan eq. 45-50), D_R = %.5g, dt = %g / D_R, equilibrate %g, average %g (1 / D_R), "
-              "d_hat %g, solver %s\n"
-              "%9s | %8s %8s | %9s | %7s %6s %6s | %9s | %7s | %8s\n",
-              o.n, o.aspect, side, o.phi, b2n, D_R, o.dt, o.equilibrate, o.average, o.d_hat, o.solver.c_str(),
-              "U0/(L DR)", "ratio", "+-", "series", "pushed", "apps", "its", "min d/dh", "S", "wall s");
-  const std::vector<sc::Pose> start = sc::periodic_random_placement(rod, o.n, side, o.d_hat, o.seed);
+  std::vector<sc::Pose> start = o.start == "aligned"
+                                    ? sc::periodic_aligned_columns(s.rod, o.n, s.side, o.d_hat, o.seed)
+                                    : sc::periodic_random_placement(s.rod, o.n, s.side, o.d_hat, o.seed);
+  std::printf("Brownian rods: N = %zu spherocylinders L/D = %g in a periodic cube of side %.4g, phi %g (hard core %.4g), "
+              "B2 n = %.5f,\nfree draining (Yan eq. 45-50), D_R = %.5g, equilibrate %g, average %g (1 / D_R), d_hat %g, "
+              "solver %s, %s directions, start %s\n",
+              o.n, o.aspect, s.side, phi, eta, b2n, s.D_R, o.equilibrate, o.average, o.d_hat, o.solver.c_str(),
+              ex::directions_name(o.directions), o.start.c_str());
+  double start_order = nematic_order(start);
+  if (o.melt > 0.0) {
+    sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);
+    const std::unique_ptr<RodStepper> melter = make_stepper(o, s, start, o.melt_dt, 0.0, mobility);
+    const long steps = std::lround(o.melt / o.melt_dt);
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long k = 0; k < steps; ++k) {
+      const sc::StepDiagnostics d = melter->step();
+      if (o.progress > 0 && (k + 1) % o.progress == 0) std::fprintf(stderr, "melt %s\n", sc::to_json(d).c_str());
+    }
+    start = melter->poses();
+    std::printf("melt: %ld steps at dt %g / D_R, nematic order %.4f -> %.4f, %.1f s\n", steps, o.melt_dt,
+                start_order, nematic_order(start),
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    start_order = nematic_order(start);
+  }
+  if (monte_carlo) std::printf("McGrother et al. 1996 (Monte Carlo, isotropic) at eta %.3f: Z = %.4f\n", eta, *monte_carlo);
+  std::printf("%9s %8s | %8s %8s | %8s %8s | %9s | %7s %6s %6s | %9s | %7s | %8s\n", "U0/(L DR)", "dt D_R", "ratio",
+              "+-", "Z", "+-", "series", "pushed", "apps", "its", "min d/dh", "S", "wall s");
   bool ok = true;
   for (const double u0_scaled : o.u0) {
-    const double u0 = u0_scaled * L * D_R;
-    sc::FreeDrainingMobility mobility(body_mobility, o.n, 6);
-    sc::TimeStepperOptions options;
-    options.dt = dt;
-    options.d_hat = o.d_hat;
-    options.box = sc::PeriodicBox{sc::Vec3::Constant(side)};
-    options.brownian.emplace();
-    options.brownian->kT = kT;
-    options.brownian->seed = o.seed;
-    sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({rod}, start, mobility,
-                                                                          sc::contact_solver_from_name(o.solver), options);
-    if (u0 > 0.0)  // self-propulsion: M F = U0 n for the force U0 zeta_par n (no torque)
-      stepper.set_external_force_field([u0, m_par](double, std::span<const sc::Pose> poses) {
-        sc::VecX F = sc::VecX::Zero(6 * static_cast<Eigen::Index>(poses.size()));
-        for (std::size_t i = 0; i < poses.size(); ++i)
-          F.segment<3>(6 * static_cast<Eigen::Index>(i)) = (u0 / m_par) * poses[i].rotation().col(2);
-        return F;
-      });
-    const ex::BrownianPressureRun r =
-        ex::measure_brownian_pressure(stepper, kT, std::lround(o.equilibrate / o.dt),
-                                      std::max(2L, std::lround(o.average / o.dt)), nematic_order);
-    const double ratio = r.measured() ? (r.z.mean(0) - 1.0) / b2n : 0.0;
-    const double error = r.measured() ? r.z.std_error(0) / b2n : 0.0;
-    const double order = r.measured() ? r.extra.mean(0) : 0.0;
-    const bool converged = r.measured() && r.z.all_converged();
-    sink.line("{\"N\": " + std::to_string(o.n) + ", \"aspect\": " + sc::json_number(o.aspect) + ", \"phi\": " +
-              sc::json_number(o.phi) + ", \"u0_over_L_DR\": " + sc::json_number(u0_scaled) + ", \"u0\": " +
-              sc::json_number(u0) + ", \"D_R\": " + sc::json_number(D_R) + ", \"dt_D_R\": " + sc::json_number(o.dt) +
-              ", \"d_hat\": " + sc::json_number(o.d_hat) + ", \"solver\": \"" + o.solver + "\", \"seed\": " +
-              std::to_string(o.seed) + ", \"steps_averaged\": " + std::to_string(r.steps) + ", \"B2n\": " +
-              sc::json_number(b2n) + ", \"Z\": " + sc::json_number(r.measured() ? r.z.mean(0) : 0.0) +
-              ", \"Z_error\": " + sc::json_number(r.measured() ? r.z.std_error(0) : 0.0) +
-              ", \"pressure_ratio\": " + sc::json_number(ratio) + ", \"pressure_ratio_error\": " +
-              sc::json_number(error) + ", \"error_converged\": " + (converged ? "true" : "false") +
-              ", \"virial_series\": " + (reference && u0 == 0.0 ? sc::json_number(*reference) : "null") +
-              ", \"nematic_order\": " + sc::json_number(order) + ", \"pushed_per_step\": " +
-              sc::json_number(r.pushed_per_step) + ", \"applications_per_step\": " +
-              sc::json_number(r.applications_per_step) + ", \"iterations_per_step\": " +
-              sc::json_number(r.iterations_per_step) + ", \"substeps_per_step\": " +
-              sc::json_number(r.substeps_per_step) + ", \"min_d_over_d_hat\": " +
-              sc::json_number(r.min_distance_ratio) + ", \"max_correction_turn\": " +
-              sc::json_number(r.max_correction_turn) + ", \"fallbacks\": " +
-              std::to_string(r.fallbacks) + ", \"wall_s\": " + sc::json_number(r.wall_s) +
-              ", \"failure\": " + sc::json_quoted(r.failure) + "}");
-    const std::string series = reference && u0 == 0.0 ? std::to_string(*reference).substr(0, 7) : "-";
-    std::printf("%9.3g | %8.4f %8.4f | %9s | %7.2f %6.2f %6.2f | %9.6f | %7.4f | %8.1f%s\n", u0_scaled, ratio, error,
-                series.c_str(), r.pushed_per_step, r.applications_per_step, r.iterations_per_step,
-                r.min_distance_ratio, order, r.wall_s, converged ? "" : "  (error bar not converged)");
-    if (r.fallbacks > 0)
-      std::printf("          %ld contact sub-step(s) failed by the solver and solved again by another; largest "
-                  "correction turn %.3g rad\n",
-                  r.fallbacks, r.max_correction_turn);
-    std::fflush(stdout);
-    if (!r.failure.empty()) {
-      std::printf("ERROR: U0 / (L D_R) = %g: %s\n", u0_scaled, r.failure.c_str());
-      ok = false;
-    } else if (o.tolerance > 0.0 && reference && u0 == 0.0 &&
-               std::abs(ratio - *reference) > o.tolerance * *reference + 3.0 * error) {
-      std::printf("ERROR: U0 = 0: Pi^col / (B2 n kT) = %g +- %g is not within %g of the virial series %g\n", ratio,
-                  error, o.tolerance, *reference);
-      ok = false;
+    const double u0 = u0_scaled * L * s.D_R;
+    std::vector<ex::ZAtStep> measured_z;
+    for (const double dt_D_R : o.dts) {
+      sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);
+      const std::unique_ptr<RodStepper> stepper = make_stepper(o, s, start, dt_D_R, u0, mobility);
+      const ex::BrownianPressureRun r =
+          ex::measure_brownian_pressure(*stepper, kT, std::lround(o.equilibrate / dt_D_R),
+                                        std::max(2L, std::lround(o.average / dt_D_R)), nematic_order);
+      const double z = r.measured() ? r.z.mean(0) : 0.0, z_error = r.measured() ? r.z.std_error(0) : 0.0;
+      const double ratio = r.measured() ? (z - 1.0) / b2n : 0.0;
+      const double error = z_error / b2n;
+      const double order = r.measured() ? r.extra.mean(0) : 0.0;
+      const bool converged = r.measured() && r.z.all_converged();
+      const sc::Vec3 n = director(stepper->poses());
+      const double z_par = 1.0 + n.dot(r.collision_stress * n);
+      const double z_perp = 1.0 + 0.5 * (r.collision_stress.trace() - n.dot(r.collision_stress * n));
+      const bool series = reference && u0 == 0.0;
+      const bool mc = monte_carlo && u0 == 0.0;
+      sink.line("{\"N\": " + std::to_string(o.n) + ", \"aspect\": " + sc::json_number(o.aspect) + ", \"phi\": " +
+                sc::json_number(phi) + ", \"eta\": " + sc::json_number(eta) + ", \"start\": \"" + o.start +
+                "\", \"melt\": " + sc::json_number(o.melt) + ", \"start_nematic_order\": " +
+                sc::json_number(start_order) + ", \"u0_over_L_DR\": " + sc::json_number(u0_scaled) +
+                ", \"u0\": " + sc::json_number(u0) + ", \"D_R\": " + sc::json_number(s.D_R) + ", \"dt_D_R\": " +
+                sc::json_number(dt_D_R) + ", \"d_hat\": " + sc::json_number(o.d_hat) + ", \"solver\": \"" +
+                o.solver + "\", \"directions\": \"" + ex::directions_name(o.directions) + "\", \"seed\": " +
+                std::to_string(o.seed) + ", \"steps_averaged\": " +
+                std::to_string(r.steps) + ", \"B2n\": " + sc::json_number(b2n) + ", \"Z\": " + sc::json_number(z) +
+                ", \"Z_error\": " + sc::json_number(z_error) + ", \"pressure_ratio\": " + sc::json_number(ratio) +
+                ", \"pressure_ratio_error\": " + sc::json_number(error) + ", \"error_converged\": " +
+                (converged ? "true" : "false") + ", \"virial_series\": " +
+                (series ? sc::json_number(*reference) : "null") + ", \"mcgrother_Z\": " +
+                (mc ? sc::json_number(*monte_carlo) : "null") + ", \"Z_parallel\": " + sc::json_number(z_par) +
+                ", \"Z_perpendicular\": " + sc::json_number(z_perp) + ", \"nematic_order\": " +
+                sc::json_number(order) + ", \"pushed_per_step\": " + sc::json_number(r.pushed_per_step) +
+                ", \"applications_per_step\": " + sc::json_number(r.applications_per_step) +
+                ", \"iterations_per_step\": " + sc::json_number(r.iterations_per_step) +
+                ", \"substeps_per_step\": " + sc::json_number(r.substeps_per_step) + ", \"min_d_over_d_hat\": " +
+                sc::json_number(r.min_distance_ratio) + ", \"max_correction_turn\": " +
+                sc::json_number(r.max_correction_turn) + ", \"fallbacks\": " + std::to_string(r.fallbacks) +
+                ", \"wall_s\": " + sc::json_number(r.wall_s) + ", \"failure\": " + sc::json_quoted(r.failure) + "}");
+      const std::string series_text = series ? std::to_string(*reference).substr(0, 7) : "-";
+      std::printf("%9.3g %8.2g | %8.4f %8.4f | %8.4f %8.4f | %9s | %7.2f %6.2f %6.2f | %9.6f | %7.4f | %8.1f%s\n",
+                  u0_scaled, dt_D_R, ratio, error, z, z_error, series_text.c_str(), r.pushed_per_step,
+                  r.applications_per_step, r.iterations_per_step, r.min_distance_ratio, order, r.wall_s,
+                  converged ? "" : "  (error bar not converged)");
+      std::printf("          collision stress along the director %.4f, across %.4f (units n kT)\n", z_par, z_perp);
+      if (r.fallbacks > 0)
+        std::printf("          %ld contact sub-step(s) failed by the solver and solved again by another; largest "
+                    "correction turn %.3g rad\n",
+                    r.fallbacks, r.max_correction_turn);
+      std::fflush(stdout);
+      if (!r.failure.empty()) {
+        std::printf("ERROR: U0 / (L D_R) = %g, dt %g / D_R: %s\n", u0_scaled, dt_D_R, r.failure.c_str());
+        ok = false;
+        continue;
+      }
+      measured_z.push_back({std::sqrt(dt_D_R), z, z_error});
+      if (o.tolerance > 0.0 && series && std::abs(ratio - *reference) > o.tolerance * *reference + 3.0 * error) {
+        std::printf("ERROR: U0 = 0: Pi^col / (B2 n kT) = %g +- %g is not within %g of the virial series %g\n", ratio,
+                    error, o.tolerance, *reference);
+        ok = false;
+      }
     }
+    if (o.dts.size() < 2 || measured_z.size() != o.dts.size()) continue;
+    const ex::Extrapolated z0 = ex::extrapolate_to_zero_step(measured_z);
+    const bool mc = monte_carlo && u0 == 0.0;
+    sink.line("{\"N\": " + std::to_string(o.n) + ", \"aspect\": " + sc::json_number(o.aspect) + ", \"eta\": " +
+              sc::json_number(eta) + ", \"u0_over_L_DR\": " + sc::json_number(u0_scaled) +
+              ", \"dt_D_R\": 0, \"extrapolated\": true, \"solver\": \"" + o.solver + "\", \"Z\": " +
+              sc::json_number(z0.z) + ", \"Z_error\": " + sc::json_number(z0.error) + ", \"slope_sqrt_dt\": " +
+              sc::json_number(z0.slope) + ", \"pressure_ratio\": " + sc::json_number((z0.z - 1.0) / b2n) +
+              ", \"pressure_ratio_error\": " + sc::json_number(z0.error / b2n) + ", \"mcgrother_Z\": " +
+              (mc ? sc::json_number(*monte_carlo) : "null") + "}");
+    std::printf("%9.3g %8s | %8.4f %8.4f | %8.4f %8.4f | slope in sqrt(dt D_R) %.3g%s\n", u0_scaled, "dt -> 0",
+                (z0.z - 1.0) / b2n, z0.error / b2n, z0.z, z0.error, z0.slope,
+                mc ? (", against McGrother " + std::to_string(*monte_carlo).substr(0, 6) + ": " +
+                      std::to_string(100.0 * (z0.z / *monte_carlo - 1.0)).substr(0, 5) + "%")
+                         .c_str()
+                   : "");
   }
   return ok ? 0 : 1;
 }

@@ -156,6 +156,23 @@ TEST(CrossingRods, DefaultSolverFallsBackToTheNearRoot) {
     EXPECT_EQ(d.fallbacks, 1u);
   }
 }
+
+// The far-root fallback is dense (SLSQP): it runs only on steps of at most
+// far_root_fallback_max_pairs flagged pairs. Below the step's pair count it is not tried, and
+// the step goes to the LCP sequence alone.
+TEST(CrossingRods, FarRootFallbackSkipsStepsWithMorePairsThanItsBound) {
+  const Crossing& c = kCrossings[0];
+  CrossingStep setup(c);
+  const auto problem = setup.problem();
+  sc::DefectCorrectionOptions bounded;
+  const sc::ContactStepResult first = sc::solve_contact_step(problem, setup.mobility, {}, bounded);
+  ASSERT_EQ(first.fallback, "barrier-working-set");
+  bounded.far_root_fallback_max_pairs = first.flagged_pairs - 1;
+  const sc::ContactStepResult r = sc::solve_contact_step(problem, setup.mobility, {}, bounded);
+  EXPECT_NE(r.fallback, "barrier-working-set");
+  EXPECT_EQ(r.message.find("barrier-working-set"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("lcp-newton"), std::string::npos) << r.message;
+}
 #endif
 
 // The time stepper sub-steps the refused step (two halves each) and commits it: every turn

@@ -1,8 +1,11 @@
-// periodic_random_placement: contact free through the minimum image (checked against every
-// image by brute force), inside the box, reproducible by seed, and clear errors.
+// periodic_random_placement and periodic_aligned_columns: contact free through the minimum
+// image (checked against every image by brute force), inside the box, reproducible by seed,
+// and clear errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -70,6 +73,41 @@ TEST(PeriodicPlacement, RejectsABoxTooSmallAndReportsAPackingItCannotFinish) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("1000 draws in a row were rejected"), std::string::npos) << e.what();
   }
+}
+
+// L / D = 5 rods at packing 0.45 (random placement jams near 0.3): every rod along z, 277 of
+// them in columns with their own z offsets, contact free across every face.
+TEST(PeriodicPlacement, AlignedColumnsReachADenseContactFreeStart) {
+  const sc::Spherocylinder rod{5.0, 0.5};
+  const double side = 14.0, gap = 0.01;
+  const double volume = std::numbers::pi * (0.25 * rod.length + 1.0 / 6.0);  // diameter 1
+  const auto count = static_cast<std::size_t>(0.45 * side * side * side / volume);
+  ASSERT_EQ(count, 277u);
+  const std::vector<sc::Pose> poses = sc::periodic_aligned_columns(rod, count, side, gap, 3);
+  ASSERT_EQ(poses.size(), count);
+  for (const sc::Pose& p : poses) {
+    EXPECT_TRUE((p.x.array() >= 0.0).all() && (p.x.array() < side).all());
+    EXPECT_LT((p.rotation().col(2) - sc::Vec3::UnitZ()).norm(), 1e-15);
+  }
+  EXPECT_GT(smallest_gap_over_images(rod, poses, side), gap);
+  // Not a layered (smectic) start: the rods' z positions spread over the box.
+  std::vector<double> z;
+  for (const sc::Pose& p : poses) z.push_back(p.x.z());
+  std::sort(z.begin(), z.end());
+  double largest_hole = z.front() + side - z.back();
+  for (std::size_t k = 1; k < z.size(); ++k) largest_hole = std::max(largest_hole, z[k] - z[k - 1]);
+  EXPECT_LT(largest_hole, 0.5);
+  const std::vector<sc::Pose> again = sc::periodic_aligned_columns(rod, count, side, gap, 3);
+  for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(poses[k].x, again[k].x);
+  EXPECT_NE(poses[0].x, sc::periodic_aligned_columns(rod, count, side, gap, 4)[0].x);
+}
+
+TEST(PeriodicPlacement, AlignedColumnsRejectAPackingTheyCannotHold) {
+  const sc::Spherocylinder rod{5.0, 0.5};
+  // 493 rods in 14^3 (packing 0.8): 247 columns of 2 on a 16 x 16 lattice of spacing 0.875 < 1.
+  test_support::expect_rejects([&] { sc::periodic_aligned_columns(rod, 493, 14.0, 0.01, 1); }, "count");
+  test_support::expect_rejects([&] { sc::periodic_aligned_columns(rod, 2, 11.9, 0.0, 1); }, "side");
+  test_support::expect_rejects([&] { sc::periodic_aligned_columns(rod, 2, 20.0, -0.1, 1); }, "min_gap");
 }
 
 }  // namespace

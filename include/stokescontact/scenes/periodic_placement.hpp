@@ -9,6 +9,19 @@
 // Cost: O(count^2) bounding-ball tests and closest points only for balls within reach, fine
 // for the dilute to moderate packings it is meant for (a few thousand bodies in seconds); the
 // rejection rate grows steeply towards random sequential addition's jamming.
+//
+// periodic_aligned_columns: a dense start for spherocylinders, the aligned start of Yan et
+// al. Sec. IV.B ("random center location but aligned orientation"), for packings beyond
+// random placement's reach (brownian_rods with 400 rods of L/D = 5, placement and one step:
+// 0.2, 1.4 and 19 s at packing 0.20, 0.25 and 0.29). Every rod lies along z; rods are
+// stacked in columns along z, m per column at spacing side / m > end-to-end length + min_gap,
+// each column shifted along z by its own uniform offset (no smectic layers), and the columns
+// sit on the sites of a k x k square lattice in xy (a random k^2 - columns of them left
+// empty), each moved by a uniform jitter that keeps neighbouring columns more than 2 radius +
+// min_gap apart. The dynamics then melts the order (or keeps it, above the isotropic-nematic
+// transition).
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -63,6 +76,52 @@ std::vector<Pose> periodic_random_placement(const S& shape, std::size_t count, d
     }
     poses.push_back(candidate);
     rejected = 0;
+  }
+  return poses;
+}
+
+// `count` spherocylinders along z in the periodic cube [0, side)^3, every gap > min_gap (see
+// the top). Throws std::invalid_argument naming "side" (too small for the minimum image or
+// for one rod per column), "min_gap" (< 0) or "count" (the columns would be closer than
+// 2 radius + min_gap: the packing is too high for aligned columns in this box).
+inline std::vector<Pose> periodic_aligned_columns(const Spherocylinder& rod, std::size_t count, double side,
+                                                  double min_gap, std::uint64_t seed) {
+  validate(rod);
+  require_non_negative(min_gap, "min_gap");
+  const double reach = 2.0 * bounding_radius(rod) + min_gap;
+  if (!(side >= 2.0 * reach))
+    fail_argument("side", "must be >= 2 (2 bounding radius + min_gap) = " + std::to_string(2.0 * reach) +
+                              " for the minimum image, got " + std::to_string(side));
+  if (count == 0) return {};
+  const double extent = rod.length + 2.0 * rod.radius + min_gap;  // a column's period must exceed it
+  const auto per_column = static_cast<std::size_t>(std::ceil(side / extent)) - 1;
+  if (per_column == 0)
+    fail_argument("side", "must exceed the rod's end-to-end length + min_gap = " + std::to_string(extent));
+  const std::size_t columns = (count + per_column - 1) / per_column;
+  const auto k = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(columns))));
+  const double spacing = side / static_cast<double>(k);
+  const double lateral = 2.0 * rod.radius + min_gap;  // columns closer than this (axis to axis) touch
+  if (!(spacing > lateral))
+    fail_argument("count", std::to_string(count) + " rods need " + std::to_string(columns) + " columns of " +
+                               std::to_string(per_column) + " on a " + std::to_string(k) + " x " +
+                               std::to_string(k) + " lattice of spacing " + std::to_string(spacing) +
+                               ", not more than 2 radius + min_gap = " + std::to_string(lateral) + " apart");
+  const double jitter = 0.5 * (spacing - lateral) * (1.0 - 1e-9);  // per coordinate, either way
+  Rng rng(seed);
+  std::vector<std::size_t> sites(k * k);
+  for (std::size_t s = 0; s < sites.size(); ++s) sites[s] = s;
+  std::shuffle(sites.begin(), sites.end(), rng);
+  std::vector<Pose> poses;
+  poses.reserve(count);
+  for (std::size_t c = 0; c < columns; ++c) {
+    // Rods of this column: count spread as evenly as the columns allow.
+    const std::size_t here = count / columns + (c < count % columns ? 1 : 0);
+    const double period = side / static_cast<double>(here);
+    const double x = (static_cast<double>(sites[c] % k) + 0.5) * spacing + uniform(rng, -jitter, jitter);
+    const double y = (static_cast<double>(sites[c] / k) + 0.5) * spacing + uniform(rng, -jitter, jitter);
+    const double offset = uniform(rng, 0.0, side);
+    for (std::size_t r = 0; r < here; ++r)
+      poses.push_back(Pose{Vec3(x, y, std::fmod(offset + static_cast<double>(r) * period, side)), Quat::Identity()});
   }
   return poses;
 }

@@ -6,7 +6,8 @@
 //   DefectCorrectionOptions   the default: Broms eq. 27 by defect correction (defect_correction.hpp);
 //                             a step it fails is solved again: a far root (a turn above
 //                             ContactStepOptions::max_correction_turn) by barrier-working-set
-//                             where NLopt is there, then any failure by the LCP sequence
+//                             where NLopt is there and the step has at most
+//                             far_root_fallback_max_pairs flagged pairs, then any failure by the LCP sequence
 //                             (solve_failed_step_again)
 //   LcpSequenceOptions        the NCP as a sequence of LCPs (Lu et al. Alg. 1; lcp_sequence.hpp)
 //   BarrierNloptOptions       the barrier method, Broms eq. 15 with NLopt (barrier_nlopt.hpp); only
@@ -205,7 +206,8 @@ ContactStepResult solve_failed_step_again(const ContactStepProblem<S>& problem, 
     return again;
   };
 #if STOKESCONTACT_HAS_NLOPT
-  if (solver.far_root_fallback && failed.max_correction_turn > options.max_correction_turn) {
+  if (solver.far_root_fallback && failed.max_correction_turn > options.max_correction_turn &&
+      failed.flagged_pairs <= solver.far_root_fallback_max_pairs) {
     BarrierNloptOptions working_set;
     working_set.constraint = BarrierConstraint::working_set;
     working_set.tol = solver.tol;

@@ -102,9 +102,14 @@ struct DefectCorrectionOptions {
   // correction turns a body by more than ContactStepOptions::max_correction_turn) by eq. 15
   // on the working set (barrier-working-set, which looks for the smallest sum of lambda and so
   // for the near root; only where the library has NLopt), then any failure by the LCP
-  // sequence (lcp-newton). Both false: the failure is returned as is.
+  // sequence (lcp-newton). Both false: the failure is returned as is. The barrier's SLSQP is
+  // dense (its cost grows like the cube of the working set), so the far-root fallback runs only
+  // on steps of at most far_root_fallback_max_pairs flagged pairs: on 400 aligned L/D = 5
+  // rods at packing 0.31 (1300 flagged pairs, docs/results.md "Dense Brownian rods") one such
+  // solve was still running 40 s into its step.
   bool far_root_fallback = true;
   bool lcp_sequence_fallback = true;
+  std::size_t far_root_fallback_max_pairs = 256;
 
   void validate() const {
     require_non_negative(margin, "DefectCorrectionOptions.margin");
