@@ -11,6 +11,7 @@
 //                   [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
 //                   [--directions particle|surface|line|overlap-ends] [--cost automatic|blocks|formed|matrix-free]
 //                   [--output FILE] [--scene FILE]
+//   fig7_rod_chains --resolution [--rings 4,6,8,12,16] [--reference-ring 24] [--output FILE]
 //
 // --cost: the contact step's cost mode (ContactStepOptions::cost; automatic takes blocks for
 // free-draining rods: no mobility application); matrix-free counts applications as the
@@ -18,6 +19,14 @@
 // --scene FILE writes the first chain at the first d_hat as a scene file for stokescontact-run
 // (its poses, the pushes as per-body forces, one step; docs/scenes.md) and runs nothing else:
 // examples/scenes/rod_chain.json is `fig7_rod_chains --d-hat 1e-2 --scene FILE`.
+//
+// --resolution: the single-body mobility of the multiblob rod grids (mobility/rod_blobs.hpp,
+// viscosity 1) per number of blobs per ring (--rings), for Fig. 7's rod and Fig. 8's (L_rod =
+// 2, R_rod = 0.5), against the grid of --reference-ring blobs per ring taken as the converged
+// value (examples/common/blob_resolution.hpp: relative errors of the translation, rotation and
+// coupling blocks and of the whole matrix); for Fig. 7's rod also the grid's parallel,
+// perpendicular and rotational mobility over Yan et al.'s slender-body theory (eq. 45-50),
+// the independent value for long rods. One JSON object per grid; nothing else runs.
 //
 // Per chain one JSON object with, per consecutive pair, d at the trial step Q* (no contact
 // forces) and after, and per flagged pair lambda / |f| (the net contact force over the push);
@@ -38,6 +47,7 @@
 #include <variant>
 #include <vector>
 
+#include "common/blob_resolution.hpp"
 #include "common/cli.hpp"
 #include "common/rod_experiment.hpp"
 
@@ -50,7 +60,8 @@ constexpr const char* kUsage =
     "usage: fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat LIST] [--solver NAME]\n"
     "                       [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
     "                       [--directions particle|surface|line|overlap-ends] [--cost automatic|blocks|formed|matrix-free]\n"
-    "                       [--output FILE] [--scene FILE]\n";
+    "                       [--output FILE] [--scene FILE]\n"
+    "       fig7_rod_chains --resolution [--rings 4,6,8,12,16] [--reference-ring 24] [--output FILE]\n";
 
 constexpr double kLRod = 0.5, kRRod = kLRod / 20.0, kDt = 0.05;  // Sec. 3.2.2
 
@@ -66,6 +77,9 @@ struct Options {
   sc::MobilityCost cost = sc::MobilityCost::automatic;
   std::string output;
   std::string scene;
+  bool resolution = false;
+  std::vector<double> rings;
+  int reference_ring = 24;
 };
 
 Options parse(int argc, char** argv) {
@@ -82,6 +96,11 @@ Options parse(int argc, char** argv) {
   o.cost = sc::mobility_cost_from_name(args.text("--cost", "automatic"), "--cost");
   o.output = args.text("--output", "");
   o.scene = args.text("--scene", "");
+  o.resolution = args.flag("--resolution");
+  o.rings = args.numbers("--rings", {4, 6, 8, 12, 16}, 3.0);
+  for (const double rings : o.rings)
+    if (rings != std::floor(rings)) throw std::invalid_argument("--rings takes whole numbers of blobs per ring");
+  o.reference_ring = static_cast<int>(args.integer("--reference-ring", 24, 3));
   args.reject_unknown();
   return o;
 }
@@ -283,6 +302,41 @@ void run_all(const Options& o, M& mobility) {
   }
 }
 
+// The rod grids per blobs per ring against the finest (see the top).
+void run_resolution(const Options& o) {
+  ex::JsonLines sink(o.output);
+  const auto grid_of = [](const sc::Spherocylinder& rod, int blobs_per_ring) {
+    sc::RodBlobResolution resolution;
+    resolution.blobs_per_ring = blobs_per_ring;
+    return sc::rod_blob_model(rod, resolution);
+  };
+  const struct {
+    const char* name;
+    sc::Spherocylinder rod;
+  } rods[] = {{"fig7 rod", ex::paper_rod(kLRod, kRRod)}, {"fig8 rod", ex::paper_rod(2.0, 0.5)}};
+  for (const auto& r : rods) {
+    const sc::BlobModel reference = grid_of(r.rod, o.reference_ring);
+    const sc::Mat6 ref = sc::single_body_mobility(reference, 1.0);
+    std::printf("%s (Spherocylinder{%g, %g}): reference %d blobs per ring, %lld blobs\n", r.name, r.rod.length,
+                r.rod.radius, o.reference_ring, static_cast<long long>(reference.positions.cols()));
+    const bool slender = r.rod.length >= 4.0 * r.rod.radius;  // Yan's theory is for long rods only
+    const sc::Mat6 sbt = slender ? sc::spherocylinder_mobility(r.rod, 1.0) : sc::Mat6::Identity();
+    for (const double rings : o.rings) {
+      const sc::BlobModel grid = grid_of(r.rod, static_cast<int>(rings));
+      const sc::Mat6 M = sc::single_body_mobility(grid, 1.0);
+      std::string row = ex::resolution_row(r.name, static_cast<std::size_t>(grid.positions.cols()), "blobs_per_ring",
+                                           rings, M, ref, sc::bounding_radius(r.rod));
+      if (slender) {  // the rod's axis is body z: parallel (2, 2), perpendicular (0, 0), rotation (3, 3)
+        row.pop_back();
+        row += ", \"parallel_over_sbt\": " + sc::json_number(M(2, 2) / sbt(2, 2)) +
+               ", \"perpendicular_over_sbt\": " + sc::json_number(M(0, 0) / sbt(0, 0)) +
+               ", \"rotation_over_sbt\": " + sc::json_number(M(3, 3) / sbt(3, 3)) + "}";
+      }
+      sink.line(row);
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -292,6 +346,10 @@ int main(int argc, char** argv) {
       [&] {
         if (!o.scene.empty()) {
           write_scene(o, o.d_hats.front());
+          return;
+        }
+        if (o.resolution) {
+          run_resolution(o);
           return;
         }
         ex::RodMobility mobility = ex::make_rod_mobility(o.mobility, ex::paper_rod(kLRod, kRRod),

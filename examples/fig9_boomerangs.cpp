@@ -32,6 +32,7 @@
 #include <variant>
 #include <vector>
 
+#include "common/blob_resolution.hpp"
 #include "common/cli.hpp"
 
 namespace sc = stokescontact;
@@ -214,26 +215,6 @@ void run(const Options& o, M& mobility) {
               ex::maximum(s.applications), ex::median(s.wall), ex::median(s.nc));
 }
 
-// Relative errors of one body's 6x6 mobility against the reference, block by block; "all": the
-// matrix scaled by the boomerang's length scale ell (u, omega ell) / (f, tau / ell), in which
-// the three blocks are of one size.
-std::string resolution_row(const std::string& model, std::size_t blobs, double spacing, const sc::Mat6& M,
-                           const sc::Mat6& ref, double ell) {
-  const auto rel = [&](int r, int c) {
-    return (M.block<3, 3>(r, c) - ref.block<3, 3>(r, c)).norm() / ref.block<3, 3>(r, c).norm();
-  };
-  sc::Vec6 scale;
-  scale << 1, 1, 1, ell, ell, ell;
-  const sc::Mat6 a = scale.asDiagonal() * M * scale.asDiagonal(), b = scale.asDiagonal() * ref * scale.asDiagonal();
-  char line[300];
-  std::snprintf(line, sizeof line,
-                "{\"record\": \"resolution\", \"model\": \"%s\", \"blobs\": %zu, \"spacing\": %s, "
-                "\"err_translation\": %.3e, \"err_rotation\": %.3e, \"err_coupling\": %.3e, \"err_all\": %.3e}",
-                model.c_str(), blobs, sc::json_number(spacing).c_str(), rel(0, 0), rel(3, 3), rel(0, 3),
-                (a - b).norm() / b.norm());
-  return line;
-}
-
 void run_resolution(const Options& o) {
   const sc::Boomerang b = sc::broms_tornberg_boomerang();
   const double ell = sc::bounding_radius(b);
@@ -243,13 +224,13 @@ void run_resolution(const Options& o) {
   std::printf("reference: surface blobs at h = %g (%lld blobs); errors relative to it\n", o.reference_spacing,
               static_cast<long long>(reference.positions.cols()));
   const sc::BlobModel curve = sc::boomerang_curve_blobs(b, o.blob_spacing);
-  sink.line(resolution_row("curve", static_cast<std::size_t>(curve.positions.cols()),
-                           o.blob_spacing > 0.0 ? o.blob_spacing : b.radius, sc::single_body_mobility(curve, 1.0), ref,
-                           ell));
+  sink.line(ex::resolution_row("curve", static_cast<std::size_t>(curve.positions.cols()), "spacing",
+                               o.blob_spacing > 0.0 ? o.blob_spacing : b.radius, sc::single_body_mobility(curve, 1.0),
+                               ref, ell));
   for (const double h : o.spacings) {
     const sc::BlobModel surface = sc::boomerang_surface_blobs(b, h);
-    sink.line(resolution_row("surface", static_cast<std::size_t>(surface.positions.cols()), h,
-                             sc::single_body_mobility(surface, 1.0), ref, ell));
+    sink.line(ex::resolution_row("surface", static_cast<std::size_t>(surface.positions.cols()), "spacing", h,
+                                 sc::single_body_mobility(surface, 1.0), ref, ell));
   }
 }
 
