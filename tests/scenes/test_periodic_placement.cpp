@@ -75,8 +75,9 @@ TEST(PeriodicPlacement, RejectsABoxTooSmallAndReportsAPackingItCannotFinish) {
   }
 }
 
-// L / D = 5 rods at packing 0.45 (random placement jams near 0.3): every rod along z, 277 of
-// them in columns with their own z offsets, contact free across every face.
+// L / D = 5 rods at packing 0.45 (brownian_rods refuses a random start at 0.3 and above):
+// every rod along z, 277 of them in columns with their own z offsets, contact free across
+// every face.
 TEST(PeriodicPlacement, AlignedColumnsReachADenseContactFreeStart) {
   const sc::Spherocylinder rod{5.0, 0.5};
   const double side = 14.0, gap = 0.01;

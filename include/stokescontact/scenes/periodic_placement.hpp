@@ -81,8 +81,8 @@ std::vector<Pose> periodic_random_placement(const S& shape, std::size_t count, d
 }
 
 // `count` spherocylinders along z in the periodic cube [0, side)^3, every gap > min_gap (see
-// the top). Throws std::invalid_argument naming "side" (too small for the minimum image or
-// for one rod per column), "min_gap" (< 0) or "count" (the columns would be closer than
+// the top). Throws std::invalid_argument naming "side" (too small for the minimum image),
+// "min_gap" (< 0) or "count" (the columns would be closer than
 // 2 radius + min_gap: the packing is too high for aligned columns in this box).
 inline std::vector<Pose> periodic_aligned_columns(const Spherocylinder& rod, std::size_t count, double side,
                                                   double min_gap, std::uint64_t seed) {
@@ -93,10 +93,9 @@ inline std::vector<Pose> periodic_aligned_columns(const Spherocylinder& rod, std
     fail_argument("side", "must be >= 2 (2 bounding radius + min_gap) = " + std::to_string(2.0 * reach) +
                               " for the minimum image, got " + std::to_string(side));
   if (count == 0) return {};
-  const double extent = rod.length + 2.0 * rod.radius + min_gap;  // a column's period must exceed it
+  // A column's period must exceed `extent`; side >= 2 reach = 2 extent leaves room for >= 1.
+  const double extent = rod.length + 2.0 * rod.radius + min_gap;
   const auto per_column = static_cast<std::size_t>(std::ceil(side / extent)) - 1;
-  if (per_column == 0)
-    fail_argument("side", "must exceed the rod's end-to-end length + min_gap = " + std::to_string(extent));
   const std::size_t columns = (count + per_column - 1) / per_column;
   const auto k = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(columns))));
   const double spacing = side / static_cast<double>(k);
