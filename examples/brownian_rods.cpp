@@ -128,24 +128,8 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// The order tensor Q = <3 n n^T - I> / 2 over the rods (n the axis, body z); the nematic order
-// parameter S is its largest eigenvalue, the director that eigenvalue's eigenvector.
-sc::Mat3 order_tensor(std::span<const sc::Pose> poses) {
-  sc::Mat3 q = sc::Mat3::Zero();
-  for (const sc::Pose& p : poses) {
-    const sc::Vec3 n = p.rotation().col(2);
-    q += 1.5 * n * n.transpose() - 0.5 * sc::Mat3::Identity();
-  }
-  return q / static_cast<double>(poses.size());
-}
-
-double nematic_order(std::span<const sc::Pose> poses) {
-  return Eigen::SelfAdjointEigenSolver<sc::Mat3>(order_tensor(poses)).eigenvalues().maxCoeff();
-}
-
-sc::Vec3 director(std::span<const sc::Pose> poses) {
-  return Eigen::SelfAdjointEigenSolver<sc::Mat3>(order_tensor(poses)).eigenvectors().col(2);  // ascending
-}
+// The nematic order parameter S (dynamics/nematic_order.hpp), as an observable of the run.
+double order_parameter(std::span<const sc::Pose> poses) { return sc::nematic_order(poses).S; }
 
 // Truncated virial series of (Z - 1) / (B2 n) at U0 = 0 for L / D = 5 (docs/results.md names
 // the source of B3 / B2^2 = 0.41946 and B4 / B2^3 = 0.05275); none for other aspects.
@@ -232,7 +216,7 @@ int run(const Options& o) {
               "solver %s, %s directions, start %s\n",
               o.n, o.aspect, s.side, phi, eta, b2n, s.D_R, o.equilibrate, o.average, o.d_hat, o.solver.c_str(),
               ex::directions_name(o.directions), o.start.c_str());
-  double start_order = nematic_order(start);
+  double start_order = order_parameter(start);
   if (o.melt > 0.0) {
     sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);
     const std::unique_ptr<RodStepper> melter = make_stepper(o, s, start, o.melt_dt, 0.0, mobility);
@@ -244,9 +228,9 @@ int run(const Options& o) {
     }
     start = melter->poses();
     std::printf("melt: %ld steps at dt %g / D_R, nematic order %.4f -> %.4f, %.1f s\n", steps, o.melt_dt,
-                start_order, nematic_order(start),
+                start_order, order_parameter(start),
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    start_order = nematic_order(start);
+    start_order = order_parameter(start);
   }
   if (monte_carlo) std::printf("McGrother et al. 1996 (Monte Carlo, isotropic) at eta %.3f: Z = %.4f\n", eta, *monte_carlo);
   std::printf("%9s %8s | %8s %8s | %8s %8s | %9s | %7s %6s %6s | %9s | %7s | %8s\n", "U0/(L DR)", "dt D_R", "ratio",
@@ -260,15 +244,15 @@ int run(const Options& o) {
       const std::unique_ptr<RodStepper> stepper = make_stepper(o, s, start, dt_D_R, u0, mobility);
       const ex::BrownianPressureRun r =
           ex::measure_brownian_pressure(*stepper, kT, std::lround(o.equilibrate / dt_D_R),
-                                        std::max(2L, std::lround(o.average / dt_D_R)), nematic_order);
+                                        std::max(2L, std::lround(o.average / dt_D_R)), order_parameter);
       const double z = r.measured() ? r.z.mean(0) : 0.0, z_error = r.measured() ? r.z.std_error(0) : 0.0;
       const double ratio = r.measured() ? (z - 1.0) / b2n : 0.0;
       const double error = z_error / b2n;
       const double order = r.measured() ? r.extra.mean(0) : 0.0;
       const bool converged = r.measured() && r.z.all_converged();
-      const sc::Vec3 n = director(stepper->poses());
-      const double z_par = 1.0 + n.dot(r.collision_stress * n);
-      const double z_perp = 1.0 + 0.5 * (r.collision_stress.trace() - n.dot(r.collision_stress * n));
+      const sc::DirectionalPressure split =
+          sc::pressure_along_and_across(r.collision_stress, sc::nematic_order(stepper->poses()).director);
+      const double z_par = 1.0 + split.along, z_perp = 1.0 + split.across;
       const bool series = reference && u0 == 0.0;
       const bool mc = monte_carlo && u0 == 0.0;
       sink.line("{\"N\": " + std::to_string(o.n) + ", \"aspect\": " + sc::json_number(o.aspect) + ", \"phi\": " +

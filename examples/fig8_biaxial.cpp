@@ -127,16 +127,6 @@ std::vector<sc::Pose> grid(const Options& o) {
   return poses;
 }
 
-// Eq. 33: S = (1/N) sum_i (3/2 (e_z . u_i)^2 - 1/2), u_i the rod's axis.
-double order_parameter(std::span<const sc::Pose> poses) {
-  double s = 0.0;
-  for (const sc::Pose& p : poses) {
-    const double c = (p.q * sc::Vec3::UnitZ()).z();
-    s += 1.5 * c * c - 0.5;
-  }
-  return s / static_cast<double>(poses.size());
-}
-
 // Table 2 of the paper: contact steps to T_end (and to T_S) for d_hat = 0.01 R_rod and
 // 0.1 R_rod, and the total steps, at dt = 0.02, 0.01, 0.005.
 struct PaperRow {
@@ -200,7 +190,7 @@ RunSummary run(const Options& o, const S& rod, double fraction, double dt, M& mo
       break;
     }
     const std::span<const sc::Pose> q(stepper.poses());
-    const double order = order_parameter(q);
+    const double order = sc::order_along(q, sc::Vec3::UnitZ());  // eq. 33
     double max_x = 0.0, max_turn = 0.0;
     for (const sc::Pose& p : q) {
       max_x = std::max(max_x, std::abs(p.x.x()));

@@ -2,7 +2,11 @@
 // Prints a readable table and writes one JSON object per shape pair.
 //
 //   geometry_demo [--output FILE]
-#include <stokescontact/stokescontact.hpp>
+
+// Only the headers it uses: a geometry program need not compile the contact solvers.
+#include <stokescontact/geometry/closest_points.hpp>
+#include <stokescontact/geometry/shapes.hpp>
+#include <stokescontact/io/json.hpp>
 
 #include <cstdio>
 #include <cstring>

@@ -6,7 +6,13 @@
 // JSON object per (model, gap).
 //
 //   pair_mobility_accuracy [--output FILE] [--max-shell 12|42|162|642]
-#include <stokescontact/stokescontact.hpp>
+
+// Only the mobility headers it uses, not the contact solvers.
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/multiblob_mobility.hpp>
+#include <stokescontact/mobility/pair_mobility_exact.hpp>
+#include <stokescontact/mobility/rpy_mobility.hpp>
+#include <stokescontact/mobility/sphere_shell.hpp>
 
 #include <array>
 #include <cstdio>

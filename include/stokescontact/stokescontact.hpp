@@ -80,6 +80,7 @@
 // dynamics
 #include "stokescontact/dynamics/background_flow.hpp"
 #include "stokescontact/dynamics/collision_stress.hpp"
+#include "stokescontact/dynamics/nematic_order.hpp"
 #include "stokescontact/dynamics/step_diagnostics.hpp"
 #include "stokescontact/dynamics/time_stepper.hpp"
 
