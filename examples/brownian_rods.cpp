@@ -253,6 +253,7 @@ int run(const Options& o) {
       const sc::DirectionalPressure split =
           sc::pressure_along_and_across(r.collision_stress, sc::nematic_order(stepper->poses()).director);
       const double z_par = 1.0 + split.along, z_perp = 1.0 + split.across;
+      const double anisotropy = sc::stress_anisotropy(r.collision_stress);  // Yan Fig. 5
       const bool series = reference && u0 == 0.0;
       const bool mc = monte_carlo && u0 == 0.0;
       sink.line("{\"N\": " + std::to_string(o.n) + ", \"aspect\": " + sc::json_number(o.aspect) + ", \"phi\": " +
@@ -269,7 +270,8 @@ int run(const Options& o) {
                 (converged ? "true" : "false") + ", \"virial_series\": " +
                 (series ? sc::json_number(*reference) : "null") + ", \"mcgrother_Z\": " +
                 (mc ? sc::json_number(*monte_carlo) : "null") + ", \"Z_parallel\": " + sc::json_number(z_par) +
-                ", \"Z_perpendicular\": " + sc::json_number(z_perp) + ", \"nematic_order\": " +
+                ", \"Z_perpendicular\": " + sc::json_number(z_perp) + ", \"stress_anisotropy\": " +
+                sc::json_number(anisotropy) + ", \"nematic_order\": " +
                 sc::json_number(order) + ", \"pushed_per_step\": " + sc::json_number(r.pushed_per_step) +
                 ", \"applications_per_step\": " + sc::json_number(r.applications_per_step) +
                 ", \"iterations_per_step\": " + sc::json_number(r.iterations_per_step) +
@@ -282,7 +284,8 @@ int run(const Options& o) {
                   u0_scaled, dt_D_R, ratio, error, z, z_error, series_text.c_str(), r.pushed_per_step,
                   r.applications_per_step, r.iterations_per_step, r.min_distance_ratio, order, r.wall_s,
                   converged ? "" : "  (error bar not converged)");
-      std::printf("          collision stress along the director %.4f, across %.4f (units n kT)\n", z_par, z_perp);
+      std::printf("          collision stress along the director %.4f, across %.4f (units n kT); sigma_max / sigma_min %.4f\n",
+                  z_par, z_perp, anisotropy);
       if (r.fallbacks > 0)
         std::printf("          %ld contact sub-step(s) failed by the solver and solved again by another; largest "
                     "correction turn %.3g rad\n",

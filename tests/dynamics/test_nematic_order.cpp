@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -116,6 +117,35 @@ TEST(NematicOrder, CollisionStressOfAlignedRodsSplitsAlongAndAcrossTheDirector) 
   }
 }
 
+// Yan's sigma_max / sigma_min: aligned rods pushed tip to tip along z (f_z), side by side along x
+// (f_x) and along y (f_y) at the middles of their overlaps give, summed, the diagonal stress
+// (sep_x f_x, sep_y f_y, sep_z f_z) in the rods' frame, so the ratio is the largest over the
+// smallest of those products, in any frame; without the push along y it is unbounded.
+TEST(NematicOrder, StressAnisotropyIsTheRatioOfTheExtremeEigenvalues) {
+  const sc::Spherocylinder rod{4.0, 0.5};
+  const double tip = 0.5 * rod.length + rod.radius, side = 2.0 * rod.radius + 0.01, column = 2.0 * tip + 0.01;
+  const double fx = 30.0, fy = 10.0, fz = 20.0;
+  Rng rng(5);
+  for (int trial = 0; trial < 4; ++trial) {
+    const Quat turn = trial == 0 ? Quat::Identity() : random_rotation(rng);
+    const auto place = [&](const Vec3& x) { return Pose{turn * x, turn}; };
+    const Vec3 ex = turn * Vec3::UnitX(), ey = turn * Vec3::UnitY(), ez = turn * Vec3::UnitZ();
+    const Pose origin = place(Vec3::Zero()), right = place(side * Vec3::UnitX()), front = place(side * Vec3::UnitY()),
+               upper = place(column * Vec3::UnitZ());
+    const Mat3 x_push = sc::collision_stress(rod, right, right.x - rod.radius * ex, rod, origin,
+                                             origin.x + rod.radius * ex, Vec3(fx * ex));
+    const Mat3 y_push = sc::collision_stress(rod, front, front.x - rod.radius * ey, rod, origin,
+                                             origin.x + rod.radius * ey, Vec3(fy * ey));
+    const Mat3 z_push = sc::collision_stress(rod, upper, upper.x - tip * ez, rod, origin, origin.x + tip * ez,
+                                             Vec3(fz * ez));
+    const double products[] = {side * fx, side * fy, column * fz};
+    const double expected = *std::max_element(products, products + 3) / *std::min_element(products, products + 3);
+    EXPECT_NEAR(sc::stress_anisotropy(x_push + y_push + z_push), expected, 1e-12 * expected) << "trial " << trial;
+    EXPECT_TRUE(std::isinf(sc::stress_anisotropy(x_push + z_push))) << "trial " << trial;
+  }
+  EXPECT_DOUBLE_EQ(sc::stress_anisotropy(2.0 * Mat3::Identity()), 1.0);
+}
+
 TEST(NematicOrder, RejectsEmptyInputAndZeroAxes) {
   const std::vector<Pose> none;
   expect_rejects([&] { sc::order_tensor(none); }, "poses");
@@ -123,6 +153,7 @@ TEST(NematicOrder, RejectsEmptyInputAndZeroAxes) {
   expect_rejects([&] { sc::order_along(one, Vec3::Zero()); }, "axis");
   expect_rejects([&] { sc::pressure_along_and_across(Mat3::Identity(), Vec3::Zero()); }, "director");
   expect_rejects([&] { sc::pressure_along_and_across(Mat3::Identity(), Vec3(NAN, 0, 0)); }, "director");
+  expect_rejects([&] { sc::stress_anisotropy(Mat3::Constant(NAN)); }, "sigma");
 }
 
 }  // namespace

@@ -5,7 +5,7 @@
 // of a Spherocylinder and of a rod's blob grid).
 //   order_tensor:  Q = (1/N) sum_i (3/2 u_i u_i^T - 1/2 I), symmetric and traceless.
 //   order_along:   e^T Q e = (1/N) sum_i (3/2 (e . u_i)^2 - 1/2), Broms & Tornberg eq. 33 with
-//                  e = e_z (the biaxial-compression grid's axis, Fig. 8c).
+//                  e = e_z (the biaxial-compression grid's axis, Fig. 8d).
 //   nematic_order: the nematic order parameter S, Q's largest eigenvalue, and the director, its
 //                  unit eigenvector (sign arbitrary), as Yan, Zhang & Shelley 2019 Sec. IV.B
 //                  use them for L/D = 5 spherocylinders (S ~ 0.2 isotropic, ~0.6 past the
@@ -17,6 +17,13 @@
 //                  n^T P n along the director n and (tr P - n^T P n) / 2, the mean over the two
 //                  directions across it: Yan Sec. IV.B's stress anisotropy. along + 2 across =
 //                  tr P, and both are invariant under a common rotation of P and n.
+//   stress_anisotropy: Yan Sec. IV.B's measure of it (Fig. 5), sigma_max / sigma_min, the
+//                  largest over the smallest eigenvalue of a collision stress tensor (its
+//                  symmetric part); +infinity where the smallest is not positive beyond
+//                  rounding, at most 1e-12 of the largest (no collision pushes across some
+//                  direction), which JSON output writes as null.
+#include <cmath>
+#include <limits>
 #include <span>
 
 #include <Eigen/Eigenvalues>
@@ -72,6 +79,14 @@ inline DirectionalPressure pressure_along_and_across(const Mat3& pressure, const
   const Vec3 n = director / norm;
   const double along = n.dot(pressure * n);
   return {along, 0.5 * (pressure.trace() - along)};
+}
+
+inline double stress_anisotropy(const Mat3& sigma) {
+  require_finite(sigma.reshaped(), "sigma");
+  const Mat3 symmetric = 0.5 * (sigma + sigma.transpose());
+  const Eigen::SelfAdjointEigenSolver<Mat3> eigen(symmetric, Eigen::EigenvaluesOnly);
+  const double smallest = eigen.eigenvalues()(0), largest = eigen.eigenvalues()(2);
+  return smallest > 1e-12 * std::abs(largest) ? largest / smallest : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace stokescontact
