@@ -79,7 +79,7 @@ for part in "${parts[@]}"; do
         done
       done
       /usr/bin/python3 scripts/plot_fig8.py docs/figures/fig8_biaxial.png $data/fig8_free_draining_*.jsonl ;;
-    scale)  # 1e3-1e6 spheres, one process per cost mode (peak memory is per process); ~3 minutes
+    scale)  # 1e3-1e6 spheres, one process per cost mode (peak memory is per process); ~8 minutes (3 repeats per size)
       mkdir -p $data/scaling
       $bin/contact_step_scaling --sizes 1000,3000,10000,30000,100000,300000,1000000 --cost blocks \
         --output $data/scaling/blocks.jsonl | tee $data/scaling/contact_step_scaling.txt

@@ -205,14 +205,19 @@ struct MinimumDistance {
 
 // Smallest d^P over all pairs: broad-phase queries with a growing cutoff (starting from the
 // largest bounding radius, times 4 per round) until a pair lies within the cutoff, which is
-// then the minimum. Open space ends at the latest once the cutoff spans all centres. In a
+// then the minimum. A caller that knows a pair's d^P passes it as `at_most`: the first
+// cutoff is then max(at_most, 0), which already holds the minimum (a pair with d^P <= c has
+// bounding balls within c), so one narrow query does (the contact step's end, where flagged
+// pairs sit near d_hat). Open space ends at the latest once the cutoff spans all centres. In a
 // periodic box the cutoff stops at the broad phase's reach, L_min/2 - 2 max bounding radius;
 // if no pair lies within it, every pair is farther apart than that and the result is the
 // minimum over all pairs' minimum images (found by brute force).
 template <Shape S>
 MinimumDistance minimum_pair_distance(std::span<const S> shapes, std::span<const Pose> poses,
-                                      const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
+                                      const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr,
+                                      double at_most = std::numeric_limits<double>::infinity()) {
   validate_scene(shapes, poses);
+  if (std::isnan(at_most)) fail_argument("at_most", "must not be NaN");
   MinimumDistance best;
   if (poses.size() < 2) return best;
   Mat3X centres;
@@ -233,7 +238,8 @@ MinimumDistance minimum_pair_distance(std::span<const S> shapes, std::span<const
   };
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
-  for (double cutoff = std::min(r_max, reach);; cutoff = std::min(4.0 * cutoff, reach)) {
+  for (double cutoff = std::min({r_max, reach, std::max(at_most, 0.0)});;
+       cutoff = std::min(std::max(4.0 * cutoff, r_max), reach)) {
     detail::measure_candidates(list.find_pairs(centres, radii, cutoff, box), distance, consider);
     if (best.distance <= cutoff || (!box && cutoff == reach)) return best;
     if (cutoff == reach) break;
@@ -246,8 +252,9 @@ MinimumDistance minimum_pair_distance(std::span<const S> shapes, std::span<const
 
 template <Shape S>
 MinimumDistance minimum_pair_distance(const S& shape, std::span<const Pose> poses,
-                                      const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
-  return minimum_pair_distance(std::span<const S>(&shape, 1), poses, box, cells);
+                                      const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr,
+                                      double at_most = std::numeric_limits<double>::infinity()) {
+  return minimum_pair_distance(std::span<const S>(&shape, 1), poses, box, cells, at_most);
 }
 
 }  // namespace stokescontact

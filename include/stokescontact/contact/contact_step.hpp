@@ -313,10 +313,15 @@ class ContactStep {
     require_finite(problem.d_try_multiplier, "d_try_multiplier");
     if (!(problem.d_try_multiplier >= 1.0))
       fail_argument("d_try_multiplier", "must be >= 1, got " + std::to_string(problem.d_try_multiplier));
-    const MinimumDistance start = minimum_pair_distance(problem.shapes, problem.poses, problem.box);
-    if (start.distance < 0.0)
-      fail_argument("poses", "Q_t must be contact free; bodies " + std::to_string(start.i) + " and " +
-                                 std::to_string(start.j) + " overlap, d = " + std::to_string(start.distance));
+    // Contact free: no pair with d^P < 0 among those with d^P <= 0 (a narrow broad phase).
+    std::vector<ContactPair> touching = find_contact_pairs(problem.shapes, problem.poses, 0.0, problem.box);
+    const auto deepest = std::min_element(touching.begin(), touching.end(), [](const auto& a, const auto& b) {
+      return a.points.distance < b.points.distance;
+    });
+    if (deepest != touching.end() && deepest->points.distance < 0.0)
+      fail_argument("poses", "Q_t must be contact free; bodies " + std::to_string(deepest->i) + " and " +
+                                 std::to_string(deepest->j) +
+                                 " overlap, d = " + std::to_string(deepest->points.distance));
     d_try_ = problem.d_try;
     if (d_try_ != 0.0) {
       require_positive(d_try_, "d_try");
@@ -331,6 +336,7 @@ class ContactStep {
         nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : contact_node_spacing(shape, problem.d_hat)));
     }
     trial_ = advance_all(problem.poses, problem.U, dofs_, problem.dt);  // Q*, eq. 16
+    scratch_poses_ = trial_;
     const std::span<const Pose> trial(trial_);
     if (d_try_ == 0.0 && problem.d_try_rule == DTryRule::relative) {
       RelativePairs found = find_pairs_relative(problem.shapes, trial, problem.U, dofs_, problem.dt, problem.d_hat,
@@ -473,23 +479,52 @@ class ContactStep {
       const Eigen::Index row = body * dofs_;
       if (e.MD_lambda.segment(row, dofs_).isZero(0.0)) return;
       moved[b] = 1;
-      const Vec3 omega = dofs_ == 6 ? Vec3(V.segment<3>(row + 3)) : Vec3::Zero();
-      e.poses[b] = advance(problem_.poses[b], V.segment<3>(row), omega, problem_.dt);  // eq. 13
+      e.poses[b] = advanced(b, V);
     });
     e.pairs.resize(pairs_.size());
     e.distances.resize(nc());
     parallel_for(nc(), [&](std::ptrdiff_t index) {
       const auto k = static_cast<std::size_t>(index);
-      const ContactPair& p = pairs_[k];
-      if (carried_[k])
-        e.pairs[k] = carried_at(*carried_[k], p, V, std::span<const Pose>(e.poses));
-      else if (k < at_trial_.size() && !moved[static_cast<std::size_t>(p.i)] && !moved[static_cast<std::size_t>(p.j)])
-        e.pairs[k] = at_trial_[k];
-      else
-        e.pairs[k] = remeasured(p, problem_.shapes, std::span<const Pose>(e.poses), problem_.box);
+      e.pairs[k] = kept_at_trial(k, moved) ? at_trial_[k] : pair_at(k, V, std::span<const Pose>(e.poses));
       e.distances(index) = e.pairs[k].points.distance;
     });
     return e;
+  }
+
+  // measure(MD_lambda).min_distance(), the same number, without forming Q: the bodies that
+  // move are advanced in a configuration kept equal to Q* between calls (and put back), and
+  // only their pairs are measured again. O(N) reads and O(pairs of moved bodies) distances,
+  // no O(N) or O(Nc) copies: the cost of a sample of a ray search (defect_correction.hpp).
+  double min_distance_at(const VecX& MD_lambda) const {
+    if (nc() == 0) return std::numeric_limits<double>::infinity();
+    const VecX V = problem_.U + MD_lambda;
+    const auto n = problem_.poses.size();
+    std::vector<char> moved(n, 0);
+    std::vector<std::size_t> moved_bodies;
+    for (std::size_t b = 0; b < n; ++b)
+      if (!MD_lambda.segment(static_cast<Eigen::Index>(b) * dofs_, dofs_).isZero(0.0)) {
+        moved[b] = 1;
+        moved_bodies.push_back(b);
+      }
+    struct PutBack {  // Q* again, also when a measurement throws
+      std::vector<Pose>& poses;
+      const std::vector<Pose>& trial;
+      const std::vector<std::size_t>& bodies;
+      ~PutBack() {
+        for (std::size_t b : bodies) poses[b] = trial[b];
+      }
+    } put_back{scratch_poses_, trial_, moved_bodies};
+    parallel_for(static_cast<std::ptrdiff_t>(moved_bodies.size()), [&](std::ptrdiff_t m) {
+      const std::size_t b = moved_bodies[static_cast<std::size_t>(m)];
+      scratch_poses_[b] = advanced(b, V);
+    });
+    VecX distances(nc());
+    parallel_for(nc(), [&](std::ptrdiff_t index) {
+      const auto k = static_cast<std::size_t>(index);
+      distances(index) = kept_at_trial(k, moved) ? at_trial_[k].points.distance
+                                                 : pair_at(k, V, std::span<const Pose>(scratch_poses_)).points.distance;
+    });
+    return distances.minCoeff();
   }
 
   // The contact matrix of the flagged pairs at an evaluated configuration: D_k, with
@@ -508,6 +543,16 @@ class ContactStep {
 
   // The barrier of eq. 15: b of eq. 10 with eps_reg = d_try (Remark 4; the value is Sec. 2.3's).
   BarrierParameters barrier_parameters_eq15() const { return barrier_parameters(problem_.d_hat, d_try_); }
+
+  // A d^P of some pair at an evaluated configuration, so at least the smallest over all pairs
+  // (minimum_pair_distance's at_most): the least distance of a flagged pair that is not
+  // carried (closest points, or an overlap end's gap, itself >= d^P); +inf when all are carried.
+  double min_distance_bound(const ContactEvaluation& e) const {
+    double bound = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < pairs_.size(); ++k)
+      if (!carried_[k]) bound = std::min(bound, e.distances(static_cast<Eigen::Index>(k)));
+    return bound;
+  }
 
   bool separated(double d) const { return d >= problem_.d_hat * (1.0 - options_.separation_margin); }
   bool all_separated(const ContactEvaluation& e) const { return nc() == 0 || separated(e.min_distance()); }
@@ -529,7 +574,10 @@ class ContactStep {
   std::size_t applications() const { return mobility_.applications() - start_applications_; }
 
  private:
-  // Pairs are only ever appended: columns of M D already formed stay valid.
+  // Pairs are only ever appended (after the constructor's first call): the columns of D, the
+  // columns of M D already formed and the measurements at Q* of the pairs before stay valid,
+  // so only the new pairs' are computed (in parallel); D and, in blocks mode, M D are then
+  // assembled again, O(Nc) sparse work.
   // A carried contact's column: its gap's gradient, in both modes (particle_contact_column
   // on its carried pair, whose two forces act at one point, the middle of the carried
   // points, so that the column keeps Newton's third law for torques too).
@@ -538,34 +586,30 @@ class ContactStep {
     const std::span<const Pose> trial(trial_);
     std::optional<BarrierParameters> weight_barrier;
     if (!nodes_.empty()) weight_barrier = detail::surface_weight_barrier(d_try_, options_.surface_weights);
-    std::vector<ContactColumn> columns;
-    columns.reserve(pairs_.size());
-    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    const std::size_t built = columns_.size();
+    columns_.resize(pairs_.size());
+    at_trial_.resize(pairs_.size());
+    parallel_for(static_cast<std::ptrdiff_t>(pairs_.size() - built), [&](std::ptrdiff_t index) {
+      const std::size_t k = built + static_cast<std::size_t>(index);
       const ContactPair& p = pairs_[k];
+      // carried pairs are measured by their gap instead
+      at_trial_[k] = carried_[k] ? p : remeasured(p, problem_.shapes, trial, problem_.box);
       const std::string field = "pairs[" + std::to_string(k) + "]";
       if (carried_[k] && carried_[k]->interior) {
-        columns.push_back(interior_column(*carried_[k], p, problem_.U));
-        continue;
+        columns_[k] = interior_column(*carried_[k], p, problem_.U);
+      } else if (!weight_barrier || carried_[k]) {
+        columns_[k] = detail::particle_contact_column(p, trial, field);
+      } else {
+        const auto i = static_cast<std::size_t>(p.i), j = static_cast<std::size_t>(p.j);
+        const SurfaceContact contact{p.i, p.j, p.image_shift,
+                                     surface_distances(shape_of(problem_.shapes, i), trial_[i], nodes_of(i),
+                                                       shape_of(problem_.shapes, j),
+                                                       shifted(trial_[j], p.image_shift), nodes_of(j), d_try_)};
+        columns_[k] = detail::surface_contact_column(contact, trial, *weight_barrier, options_.surface_weights, field);
       }
-      if (!weight_barrier || carried_[k]) {
-        columns.push_back(detail::particle_contact_column(p, trial, field));
-        continue;
-      }
-      const auto i = static_cast<std::size_t>(p.i), j = static_cast<std::size_t>(p.j);
-      const SurfaceContact contact{p.i, p.j, p.image_shift,
-                                   surface_distances(shape_of(problem_.shapes, i), trial_[i], nodes_of(i),
-                                                     shape_of(problem_.shapes, j), shifted(trial_[j], p.image_shift),
-                                                     nodes_of(j), d_try_)};
-      columns.push_back(
-          detail::surface_contact_column(contact, trial, *weight_barrier, options_.surface_weights, field));
-    }
-    D_ = assemble_contact_matrix(columns, trial_.size(), dofs_);
-    columns_ = std::move(columns);
+    });
+    D_ = assemble_contact_matrix(columns_, trial_.size(), dofs_);
     if (M_blocks_.rows() > 0) MD_ = M_blocks_ * D_;  // blocks mode, once M is set (the constructor's end)
-    at_trial_.clear();
-    at_trial_.reserve(pairs_.size());
-    for (std::size_t k = 0; k < pairs_.size(); ++k)  // carried pairs are measured by their gap instead
-      at_trial_.push_back(carried_[k] ? pairs_[k] : remeasured(pairs_[k], problem_.shapes, trial, problem_.box));
   }
 
   // With overlap_ends directions, the pairs from `first` on that are not carried become
@@ -661,6 +705,27 @@ class ContactStep {
     return column;
   }
 
+  // Body b at the end of the step with velocities V (eq. 13).
+  Pose advanced(std::size_t b, const VecX& V) const {
+    const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs_;
+    const Vec3 omega = dofs_ == 6 ? Vec3(V.segment<3>(row + 3)) : Vec3::Zero();
+    return advance(problem_.poses[b], V.segment<3>(row), omega, problem_.dt);
+  }
+
+  // Whether pair k keeps its measurement at Q* (at_trial_) when the bodies marked in `moved`
+  // have left their trial poses: neither of its bodies moved, and it is not carried.
+  bool kept_at_trial(std::size_t k, const std::vector<char>& moved) const {
+    const ContactPair& p = pairs_[k];
+    return !carried_[k] && k < at_trial_.size() && !moved[static_cast<std::size_t>(p.i)] &&
+           !moved[static_cast<std::size_t>(p.j)];
+  }
+
+  // Pair k measured again at `poses`, reached with velocities V (a carried contact by its gap).
+  ContactPair pair_at(std::size_t k, const VecX& V, std::span<const Pose> poses) const {
+    if (carried_[k]) return carried_at(*carried_[k], pairs_[k], V, poses);
+    return remeasured(pairs_[k], problem_.shapes, poses, problem_.box);
+  }
+
   // Inside the step a pair need only stay apart: an interior contact holds its gap at d_hat
   // less this, half of d_hat (clear of the whole-step check's overlap threshold).
   double interior_offset() const { return 0.5 * problem_.d_hat; }
@@ -682,6 +747,8 @@ class ContactStep {
   double d_try_ = 0.0;
   std::size_t start_applications_ = 0;
   std::vector<Pose> trial_;  // Q*
+  // Q* again, in which min_distance_at moves bodies for one call and then puts them back.
+  mutable std::vector<Pose> scratch_poses_;
   std::vector<ContactPair> pairs_;                    // carried ones: their carried pair at Q*
   std::vector<std::optional<CarriedContact>> carried_;  // per pair: carried or not
   std::vector<SurfaceNodes> nodes_;  // per shape, for d^S directions (empty: d^P)
@@ -737,6 +804,8 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   ContactStepResult r;
   ContactSolveOutcome outcome;
   std::vector<ContactPair> violating;
+  // The smallest d^P of the last Q(lambda) checked, when its end query held it (NaN: not known).
+  double end_minimum = std::numeric_limits<double>::quiet_NaN();
   std::vector<TrajectoryCrossing> crossing;
   std::string beyond_box;  // why the corrected motion could not be checked in the box, if so
   // Overlaps deeper than separation_margin d_hat count, found within a tenth of that.
@@ -747,9 +816,19 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
     r.iterations = iterations + outcome.iterations;
     r.guarantee_rounds = round;
     const ContactEvaluation& e = step.evaluate(outcome.lambda);
-    // The end: all pairs, not only the flagged ones.
-    violating = find_contact_pairs(problem.shapes, std::span<const Pose>(e.poses),
-                                   problem.d_hat * (1.0 - options.separation_margin), problem.box);
+    // The end: all pairs, not only the flagged ones. The query reaches the least flagged
+    // distance too, so that its pairs hold the smallest d^P of Q(lambda) (the result's
+    // min_distance_ratio): one broad phase for both.
+    // (At most d_try: a reach the trial step's detection already used, so a periodic box holds it.)
+    const double bound = step.min_distance_bound(e);
+    const double below = problem.d_hat * (1.0 - options.separation_margin);
+    const double reach = std::max(below, std::min(bound, step.d_try()));
+    violating = find_contact_pairs(problem.shapes, std::span<const Pose>(e.poses), reach, problem.box);
+    end_minimum = std::numeric_limits<double>::quiet_NaN();
+    if (bound <= reach) {  // (bound is a pair's distance too, should rounding drop it at the cutoff)
+      end_minimum = bound;
+      for (const ContactPair& p : violating) end_minimum = std::min(end_minimum, p.points.distance);
+    }
     std::erase_if(violating, [&](const ContactPair& p) { return step.separated(p.points.distance); });
     // The interior: no overlap along the corrected motion.
     const VecX V = problem.U + e.MD_lambda;
@@ -783,8 +862,11 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   r.velocities = problem.U + e.MD_lambda;
   r.poses = e.poses;
   r.d_try = step.d_try();
-  r.min_distance_ratio =
-      minimum_pair_distance(problem.shapes, std::span<const Pose>(r.poses), problem.box).distance / problem.d_hat;
+  if (std::isnan(end_minimum))  // the end query did not reach it (no flagged pair below d_try)
+    end_minimum = minimum_pair_distance(problem.shapes, std::span<const Pose>(r.poses), problem.box, nullptr,
+                                        step.min_distance_bound(e))
+                      .distance;
+  r.min_distance_ratio = end_minimum / problem.d_hat;
   const std::vector<double> d(e.distances.begin(), e.distances.end());
   r.barrier_energy = barrier_energy(d, step.barrier_parameters_eq15());
   r.complementarity_residual = detail::complementarity_residual(r.lambda, e.distances, problem.d_hat);

@@ -209,7 +209,7 @@ struct WorkingSetLcp {
 // (Broms eq. 13), given M D lambda: no mobility application.
 template <Shape S, MobilityOperator M>
 double min_flagged_distance_at(const ContactStep<S, M>& step, const VecX& MD_lambda) {
-  return step.measure(MD_lambda).min_distance();
+  return step.min_distance_at(MD_lambda);
 }
 
 // A ray of forces lambda(s) = base + s direction, s > 0, with M D of both (so every point
