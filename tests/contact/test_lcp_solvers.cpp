@@ -479,4 +479,62 @@ TEST(LcpSolvers, LargeSparseProblemAllThreeAgree) {
   }
 }
 
+// A jammed cluster: 3000 unit spheres on a 30 x 100 square lattice (x, y) touching their
+// neighbours, free draining with M = I, every pair pushed together by a force towards the
+// lattice's centre line: A = D^T D is the edge Laplacian of the lattice (condition ~1e4, as
+// the Delassus matrix of one large connected cluster), b < 0 on most pairs.
+// Minimum-map Newton with the sparse matrix itself as its preconditioner (what the default
+// solver's working set passes: its sparse model) takes at most a third of the applications of
+// A that unpreconditioned GMRES takes (measured: 160 against 621, the first 50 Arnoldi steps
+// of each direction being unpreconditioned), for the same solution; an indefinite preconditioner is not used
+// (the same solution at the unpreconditioned cost); one of the wrong size is rejected by name.
+TEST(LcpSolvers, PreconditionedNewtonSolvesALargeClusterInFewApplications) {
+  constexpr Eigen::Index nx = 30, ny = 100;
+  const auto body = [&](Eigen::Index x, Eigen::Index y) { return x + nx * y; };
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<double> push;
+  Eigen::Index c = 0;
+  for (Eigen::Index y = 0; y < ny; ++y)
+    for (Eigen::Index x = 0; x < nx; ++x)
+      for (const auto& [dx, dy] : {std::pair<Eigen::Index, Eigen::Index>{1, 0}, {0, 1}}) {
+        if (x + dx >= nx || y + dy >= ny) continue;
+        const Eigen::Index i = body(x, y), j = body(x + dx, y + dy), axis = dx == 1 ? 0 : 1;
+        entries.emplace_back(3 * j + axis, c, 1.0);  // the normal from i to j, on j; minus it on i
+        entries.emplace_back(3 * i + axis, c, -1.0);
+        // closing velocity: pairs across the centre line y = ny / 2 are pushed hardest
+        push.push_back(dy == 1 ? -1.0 - 0.01 * static_cast<double>(std::min(y, ny - 1 - y)) : 0.5);
+        ++c;
+      }
+  SparseMat D(3 * nx * ny, c);
+  D.setFromTriplets(entries.begin(), entries.end());
+  const SparseMat A = SparseMat(D.transpose() * D);
+  const sc::VecX b = Eigen::Map<const sc::VecX>(push.data(), c);
+  const sc::LcpOptions options{.tolerance = 1e-8, .max_iterations = 200};
+  const sc::LcpResult plain = sc::solve_lcp_minimum_map_newton(A, b, options);
+  const sc::LcpResult preconditioned = sc::solve_lcp_minimum_map_newton(A, b, options, nullptr, &A);
+  ASSERT_TRUE(plain.converged) << plain.residual;
+  ASSERT_TRUE(preconditioned.converged) << preconditioned.residual;
+  std::printf("  lattice cluster, %ld pairs, %ld active: %zu applications unpreconditioned, %zu preconditioned\n",
+              static_cast<long>(c), static_cast<long>((preconditioned.gamma.array() > 0.0).count()),
+              plain.operator_applications, preconditioned.operator_applications);
+  EXPECT_GT((preconditioned.gamma.array() > 0.0).count(), c / 3);
+  EXPECT_LE(3 * preconditioned.operator_applications, plain.operator_applications);
+  const double scale = std::max(1.0, plain.gamma.cwiseAbs().maxCoeff());
+  EXPECT_LE((preconditioned.gamma - plain.gamma).cwiseAbs().maxCoeff(), 1e-6 * scale);
+
+  const SparseMat indefinite = SparseMat(-A);
+  const sc::LcpResult unused = sc::solve_lcp_minimum_map_newton(A, b, options, nullptr, &indefinite);
+  ASSERT_TRUE(unused.converged) << unused.residual;
+  EXPECT_GT(3 * unused.operator_applications, plain.operator_applications);
+  EXPECT_LE((unused.gamma - plain.gamma).cwiseAbs().maxCoeff(), 1e-6 * scale);
+
+  const SparseMat wrong(c + 1, c + 1);
+  try {
+    sc::solve_lcp_minimum_map_newton(A, b, options, nullptr, &wrong);
+    ADD_FAILURE() << "a wrong-size preconditioner was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("preconditioner"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace lcp_solvers_tests

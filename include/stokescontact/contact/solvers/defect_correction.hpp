@@ -66,11 +66,13 @@
 // Iterations reported: corrections (LCPs solved).
 #include <algorithm>
 #include <cmath>
+#include <concepts>
 #include <limits>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -183,7 +185,12 @@ std::optional<VecX> solve_working_set_lcp(const Model& A, std::span<const Eigen:
   if constexpr (is_eigen_matrix<Model>) A_lambda_W = A * lambda_W;
   else A_lambda_W = A(lambda_W);
   const VecX b = d_W - VecX::Constant(n, target) - A_lambda_W;
-  const LcpResult lcp = solve_lcp_minimum_map_newton(A, b, options, &lambda_W);
+  // A sparse model (or the sparse matrix a secant correction corrects) preconditions Newton's GMRES.
+  const Eigen::SparseMatrix<double>* sparse_part = nullptr;
+  if constexpr (std::is_same_v<Model, Eigen::SparseMatrix<double>>) sparse_part = &A;
+  else if constexpr (requires { { A.base() } -> std::same_as<const Eigen::SparseMatrix<double>&>; })
+    sparse_part = &A.base();
+  const LcpResult lcp = solve_lcp_minimum_map_newton(A, b, options, &lambda_W, sparse_part);
   if (!lcp.converged) return std::nullopt;
   VecX next = VecX::Zero(lambda.size());
   for (Eigen::Index r = 0; r < n; ++r) next(W[static_cast<std::size_t>(r)]) = lcp.gamma(r);

@@ -41,6 +41,7 @@ class SecantCorrection {
    public:
     explicit Model(const Matrix& A0) : A0_(A0) {}
     Model(const Matrix& A0, MatX left, const MatX& S) : A0_(A0), left_(std::move(left)), steps_(S) {}
+    const Matrix& base() const { return A0_; }  // A0, the matrix corrected
     VecX operator()(const VecX& x) const {
       VecX out = A0_ * x;
       if (left_.cols() > 0) out += left_ * VecX(steps_.solve(x));  // S^+ x: the minimum-norm least squares
