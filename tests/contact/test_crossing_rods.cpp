@@ -5,12 +5,14 @@
 // pressed into each other by +-f across their axes with random torques: the trial step
 // overlaps deeply. Eq. 13 is linear in the rotation, so the end gap of the pair can reach
 // d_hat again far along the force: the default solver and the LCP sequence both find such a
-// root, lambda ~3000 (7-14x the push) with a correction that turns a rod by 1.1-1.7 rad and
-// leaves the pair 13-15 d_hat apart, or overlapping (the LCP sequence), instead of at d_hat.
+// root, lambda 1700-3000 (7-9x the push) with a correction that turns a rod by 1.1-1.7 rad and
+// leaves the pair 13-31 d_hat apart, or overlapping (the LCP sequence), instead of at d_hat.
 // Before the guard the default solver reported those steps converged. The cases were drawn at
 // random (theta in [0.02, 0.62] rad, offset along the lower rod in [-2, 2], gap in [1, 3]
 // d_hat, f in [100, 500], torques uniform in +-f/2): 350 of 3000 draws gave the default
-// solver a converged step turning a rod by more than 0.3 rad; these two are the clearest.
+// solver a converged step turning a rod by more than 0.3 rad; these two are among the clearest
+// (since the working-set LCP starts from BBPGD, 331 of 3000 draws of another stream, 338 before;
+// the second case of this file's first version, theta 0.251, now converges at a near root).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -45,9 +47,9 @@ const std::array<Crossing, 2> kCrossings{{
     {0.15862556832129365, -0.040571916508695738, 0.018759502886215411, 432.31320527038827,
      {-48.841442189236169, 45.348015336454012, 206.47794548828202, -171.54293815880769, 203.60249147153934,
       -171.75908546108772}},
-    {0.25109555644153908, -0.013718888686470532, 0.023081885321589564, 250.14469397717531,
-     {9.3310516141692972, 29.228218062689852, -116.5056176186972, 123.3194148285735, -32.576853857615014,
-      60.833443036933787}},
+    {0.087755492150681763, 1.0807844525445391, 0.024066728486121805, 188.80778361765263,
+     {41.12123587137247, -43.838492127817176, 12.973027593196255, 23.794488762808164, -40.280091991139003,
+      -42.228236537594341}},
 }};
 
 // The lower rod along x at the origin, the upper one turned by theta about y, above it.
@@ -108,7 +110,7 @@ TEST(CrossingRods, FarRootIsNotReportedConverged) {
     }
 
     // Without the guard the default solver calls it converged: every end gap holds, but the
-    // pair ends more than 10 d_hat apart, pushed by 7x the force that pressed it.
+    // pair ends more than 10 d_hat apart, pushed by 7-9x the force that pressed it.
     sc::ContactStepOptions unguarded;
     unguarded.max_correction_turn = 1e9;
     const sc::ContactStepResult far = sc::solve_contact_step(problem, mobility, unguarded);

@@ -59,9 +59,9 @@
 // one exact column of M D (cached by the step), A~ = A, and the iterations are free; in
 // blocks mode (free draining) A~ = A is read from the sparse M D and nothing costs an application.
 // Nothing is dense in the working set: A~ is sparse (delassus_probing.hpp), its LCP is solved
-// with products only (GMRES inside minimum-map Newton), the secant correction is a low-rank
-// operator (secant_update.hpp), and the lift to positive definite is a diagonal shift beyond
-// 200 pairs. Time and memory per correction are O(Nc + nnz A~) besides the application: one
+// with products only (GMRES inside minimum-map Newton, started from BBPGD on A~), the secant
+// correction is a low-rank operator (secant_update.hpp), and the lift to positive definite is a
+// diagonal shift beyond 200 pairs. Time and memory per correction are O(Nc + nnz A~) besides the application: one
 // step of 1e6 free-draining spheres with 9e4 pushed pairs ran in 1.1 GB (docs/results.md).
 // Iterations reported: corrections (LCPs solved).
 #include <algorithm>
@@ -82,6 +82,7 @@
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/solvers/delassus_probing.hpp"
 #include "stokescontact/lcp/minimum_map_newton.hpp"
+#include "stokescontact/lcp/bbpgd.hpp"
 #include "stokescontact/contact/solvers/secant_update.hpp"
 #include "stokescontact/contact/solvers/lcp_sequence.hpp"
 
@@ -172,6 +173,7 @@ inline Eigen::SparseMatrix<double> positive_definite(const Eigen::SparseMatrix<d
 // The working set's LCP of the linear model about the current iterate (A: the model on W, a
 // matrix or an operator; distances: all flagged pairs at the iterate); the new lambda on all
 // pairs, none if the LCP solver did not converge.
+inline constexpr LcpOptions kGradientStart{1e-3, 200};  // BBPGD's start for minimum-map Newton
 template <LcpMatrixOperator Model>
 std::optional<VecX> solve_working_set_lcp(const Model& A, std::span<const Eigen::Index> W, const VecX& lambda,
                                           const VecX& distances, double target, const LcpOptions& options) {
@@ -190,7 +192,18 @@ std::optional<VecX> solve_working_set_lcp(const Model& A, std::span<const Eigen:
   if constexpr (std::is_same_v<Model, Eigen::SparseMatrix<double>>) sparse_part = &A;
   else if constexpr (requires { { A.base() } -> std::same_as<const Eigen::SparseMatrix<double>&>; })
     sparse_part = &A.base();
-  const LcpResult lcp = solve_lcp_minimum_map_newton(A, b, options, &lambda_W, sparse_part);
+  // Where there is a sparse model, Newton starts from BBPGD's first iterate within 1e-3 on its
+  // LCP (symmetric and lifted to positive definite; one sparse product per step): from the
+  // previous iterate alone, Newton crawled where many pairs change sides at once (a jammed
+  // packing's guarantee round: 26 Newton steps at tau down to 1/256, the active set shrinking by
+  // one pair per step; 3-5 steps from BBPGD's start, docs/results.md). A secant-corrected model
+  // is not symmetric, and BB steps on it can diverge: its sparse part is used instead.
+  VecX start = lambda_W;
+  if (sparse_part) {
+    const VecX b_sparse = d_W - VecX::Constant(n, target) - *sparse_part * lambda_W;
+    start = solve_lcp_bbpgd(*sparse_part, b_sparse, kGradientStart, &lambda_W).gamma;
+  }
+  const LcpResult lcp = solve_lcp_minimum_map_newton(A, b, options, &start, sparse_part);
   if (!lcp.converged) return std::nullopt;
   VecX next = VecX::Zero(lambda.size());
   for (Eigen::Index r = 0; r < n; ++r) next(W[static_cast<std::size_t>(r)]) = lcp.gamma(r);
