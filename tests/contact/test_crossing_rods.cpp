@@ -5,14 +5,14 @@
 // pressed into each other by +-f across their axes with random torques: the trial step
 // overlaps deeply. Eq. 13 is linear in the rotation, so the end gap of the pair can reach
 // d_hat again far along the force: the default solver and the LCP sequence both find such a
-// root, lambda 1700-3000 (7-9x the push) with a correction that turns a rod by 1.1-1.7 rad and
+// root, lambda 1700-3000 (7-10x the push) with a correction that turns a rod by 1.1-1.7 rad and
 // leaves the pair 13-31 d_hat apart, or overlapping (the LCP sequence), instead of at d_hat.
 // Before the guard the default solver reported those steps converged. The cases were drawn at
 // random (theta in [0.02, 0.62] rad, offset along the lower rod in [-2, 2], gap in [1, 3]
 // d_hat, f in [100, 500], torques uniform in +-f/2): 350 of 3000 draws gave the default
 // solver a converged step turning a rod by more than 0.3 rad; these two are among the clearest
-// (since the working-set LCP starts from BBPGD, 331 of 3000 draws of another stream, 338 before;
-// the second case of this file's first version, theta 0.251, now converges at a near root).
+// (the second case of this file's first version, theta 0.251, converges at a near root since
+// the working-set LCP starts from BBPGD).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -110,7 +110,7 @@ TEST(CrossingRods, FarRootIsNotReportedConverged) {
     }
 
     // Without the guard the default solver calls it converged: every end gap holds, but the
-    // pair ends more than 10 d_hat apart, pushed by 7-9x the force that pressed it.
+    // pair ends more than 10 d_hat apart, pushed by 7-10x the force that pressed it.
     sc::ContactStepOptions unguarded;
     unguarded.max_correction_turn = 1e9;
     const sc::ContactStepResult far = sc::solve_contact_step(problem, mobility, unguarded);

@@ -61,8 +61,9 @@
 // Nothing is dense in the working set: A~ is sparse (delassus_probing.hpp), its LCP is solved
 // with products only (GMRES inside minimum-map Newton, started from BBPGD on A~), the secant
 // correction is a low-rank operator (secant_update.hpp), and the lift to positive definite is a
-// diagonal shift beyond 200 pairs. Time and memory per correction are O(Nc + nnz A~) besides the application: one
-// step of 1e6 free-draining spheres with 9e4 pushed pairs ran in 1.1 GB (docs/results.md).
+// diagonal shift beyond 200 pairs. Time and memory per correction are O(Nc + nnz A~) besides
+// the application: one step of 1e6 free-draining spheres with 9e4 pushed pairs ran in 1.1 GB
+// (docs/results.md).
 // Iterations reported: corrections (LCPs solved).
 #include <algorithm>
 #include <cmath>
@@ -200,7 +201,9 @@ std::optional<VecX> solve_working_set_lcp(const Model& A, std::span<const Eigen:
   // is not symmetric, and BB steps on it can diverge: its sparse part is used instead.
   VecX start = lambda_W;
   if (sparse_part) {
-    const VecX b_sparse = d_W - VecX::Constant(n, target) - *sparse_part * lambda_W;
+    const VecX b_sparse = std::is_same_v<Model, Eigen::SparseMatrix<double>>
+                              ? b
+                              : VecX(d_W - VecX::Constant(n, target) - *sparse_part * lambda_W);
     start = solve_lcp_bbpgd(*sparse_part, b_sparse, kGradientStart, &lambda_W).gamma;
   }
   const LcpResult lcp = solve_lcp_minimum_map_newton(A, b, options, &start, sparse_part);
