@@ -9,7 +9,10 @@
 // detection (find_contact_pairs at d_try = 0.1) and the smallest distance over all pairs
 // (minimum_pair_distance), whose pair loops parallel_for shares out over OpenMP threads
 // (run with OMP_NUM_THREADS=1 and 2 to see their scaling).
+// Counter page_faults: the process's minor page faults per iteration (getrusage), the pages a
+// step touches for the first time: on a virtual machine each costs microseconds.
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 
 #include <cstddef>
 #include <map>
@@ -23,6 +26,18 @@
 namespace {
 
 using namespace stokescontact;
+
+long minor_faults() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_minflt;
+}
+
+// Minor page faults per iteration since `first` (taken before the loop).
+void count_page_faults(benchmark::State& state, long first) {
+  state.counters["page_faults"] = benchmark::Counter(static_cast<double>(minor_faults() - first),
+                                                     benchmark::Counter::kAvgIterations);
+}
 
 void run(benchmark::State& state, MobilityCost cost) {
   const auto n = static_cast<std::size_t>(state.range(0));
@@ -40,10 +55,12 @@ void run(benchmark::State& state, MobilityCost cost) {
   ContactStepOptions options;
   options.cost = cost;
   ContactStepResult r;
+  const long faults = minor_faults();
   for (auto _ : state) {
     r = solve_contact_step_defect_correction(problem, mobility, options);
     benchmark::DoNotOptimize(r.lambda.data());
   }
+  count_page_faults(state, faults);
   if (r.status != ContactStepStatus::converged) state.SkipWithError(r.message.c_str());
   state.counters["flagged"] = static_cast<double>(r.flagged_pairs);
   state.counters["pushed"] = static_cast<double>((r.lambda.array() > 0.0).count());
@@ -69,11 +86,13 @@ void BM_FindContactPairs(benchmark::State& state) {
   const SpherePacking& packing = packing_of(n);
   CellList cells;
   std::size_t flagged = 0;
+  const long faults = minor_faults();
   for (auto _ : state) {
     const std::vector<ContactPair> pairs = find_contact_pairs(Sphere{1.0}, packing.poses, 0.1, {}, &cells);
     benchmark::DoNotOptimize(pairs.data());
     flagged = pairs.size();
   }
+  count_page_faults(state, faults);
   state.counters["flagged"] = static_cast<double>(flagged);
   state.counters["time_per_sphere"] = benchmark::Counter(
       static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
@@ -83,7 +102,9 @@ void BM_MinimumPairDistance(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
   const SpherePacking& packing = packing_of(n);
   CellList cells;
+  const long faults = minor_faults();
   for (auto _ : state) benchmark::DoNotOptimize(minimum_pair_distance(Sphere{1.0}, packing.poses, {}, &cells).distance);
+  count_page_faults(state, faults);
   state.counters["time_per_sphere"] = benchmark::Counter(
       static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }

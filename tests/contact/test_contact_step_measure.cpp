@@ -7,7 +7,9 @@
 //   - the result's min_distance_ratio (read from the end check's broad phase, or from
 //     minimum_pair_distance with the least flagged distance as at_most) is the smallest d^P
 //     over all pairs of the new configuration, computed independently;
-//   - minimum_pair_distance with an at_most bound gives the same minimum as without.
+//   - minimum_pair_distance with an at_most bound gives the same minimum as without;
+//   - evaluate(), which reuses the storage of its previous evaluation, gives measure()'s
+//     numbers bit for bit, also after pairs are added.
 // Scenes: 2000 spheres at packing 0.3 (open space, blocks mode), 300 spheres in a periodic
 // box, and 120 rods in a periodic box pushed and turned hard enough that pairs pass through
 // each other in the trial step (carried contacts), with particle and overlap-ends directions.
@@ -124,6 +126,22 @@ void expect_trial_measurements_fresh(const sc::ContactStep<S, sc::FreeDrainingMo
   EXPECT_GT(compared, step.pairs().size() / 2);
 }
 
+// evaluate() reuses the storage of the evaluation before (poses, pairs, distances): what it
+// returns must be a fresh measurement's numbers, bit for bit, whatever was there.
+void expect_same_evaluation(const sc::ContactEvaluation& reused, const sc::ContactEvaluation& fresh) {
+  ASSERT_EQ(reused.distances.size(), fresh.distances.size());
+  ASSERT_EQ(reused.pairs.size(), fresh.pairs.size());
+  ASSERT_EQ(reused.poses.size(), fresh.poses.size());
+  EXPECT_TRUE(reused.MD_lambda == fresh.MD_lambda);
+  EXPECT_TRUE(reused.distances == fresh.distances);
+  for (std::size_t k = 0; k < fresh.pairs.size(); ++k)
+    EXPECT_TRUE(reused.pairs[k].points.normal == fresh.pairs[k].points.normal) << "pair " << k;
+  for (std::size_t b = 0; b < fresh.poses.size(); ++b) {
+    EXPECT_TRUE(reused.poses[b].x == fresh.poses[b].x) << "body " << b;
+    EXPECT_TRUE(reused.poses[b].q.coeffs() == fresh.poses[b].q.coeffs()) << "body " << b;
+  }
+}
+
 template <sc::Shape S>
 void expect_min_distance_at_is_measure(const Scene<S>& s, const sc::ContactStepOptions& options, double scale) {
   sc::FreeDrainingMobility m = mobility_for(s);
@@ -135,9 +153,11 @@ void expect_min_distance_at_is_measure(const Scene<S>& s, const sc::ContactStepO
     int sample = 0;
     for (const sc::VecX& lambda : force_samples(step.nc(), scale, 11 + static_cast<std::uint64_t>(round))) {
       const sc::VecX MD = step.MD_times(lambda);
-      const double full = step.measure(MD).min_distance();
+      const sc::ContactEvaluation measured = step.measure(MD);
+      const double full = measured.min_distance();
       EXPECT_EQ(step.min_distance_at(MD), full) << "sample " << sample;
       EXPECT_EQ(step.min_distance_at(MD), full) << "sample " << sample << ", called again";
+      expect_same_evaluation(step.evaluate(lambda), measured);  // in the last one's storage
       ++sample;
     }
     expect_trial_measurements_fresh(step, s);

@@ -81,7 +81,7 @@ ContactPair contact_pair(std::span<const S> shapes, std::span<const Pose> poses,
   const S& a = shape_of(shapes, si);
   const S& b = shape_of(shapes, sj);
   const Pose pose_b = shifted(poses[sj], pair.image_shift);
-  pair.points = closest_points(a, poses[si], b, pose_b);
+  pair.points = closest_points_of_valid(a, poses[si], b, pose_b);  // the callers validate the scene
   if constexpr (std::is_same_v<S, LineContactRod>) {
     const auto line = line_contact(to_world(centre_curve(a), poses[si]).segments[0],
                                    to_world(centre_curve(b), pose_b).segments[0],
@@ -153,7 +153,8 @@ std::vector<ContactPair> split_overlap_ends(std::vector<ContactPair> pairs, std:
   }
 }
 
-// Pair p (as flagged, perhaps an overlap end) measured again at poses.
+// Pair p (as flagged, perhaps an overlap end) measured again at poses, which must be valid
+// (validate_scene): the contact step calls it per pair and correction on poses it made.
 template <Shape S>
 ContactPair remeasured(const ContactPair& p, std::span<const S> shapes, std::span<const Pose> poses,
                        const std::optional<PeriodicBox>& box) {
@@ -180,13 +181,23 @@ std::vector<ContactPair> find_contact_pairs(std::span<const S> shapes, std::span
   detail::broad_phase_input(shapes, poses, centres, radii);
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
+  const std::vector<BodyPair>& candidates = list.find_pairs(centres, radii, d_try, box);
   std::vector<ContactPair> flagged;
-  detail::measure_candidates(
-      list.find_pairs(centres, radii, d_try, box),
-      [&](const BodyPair& c) { return detail::contact_pair(shapes, poses, c.i, c.j, box); },
-      [&](const BodyPair&, ContactPair& pair) {
-        if (pair.points.distance <= d_try) flagged.push_back(std::move(pair));
-      });
+  const auto measure = [&](const BodyPair& c) { return detail::contact_pair(shapes, poses, c.i, c.j, box); };
+  if constexpr (std::is_same_v<S, Sphere>) {
+    // A sphere is its bounding ball: (nearly) every candidate is flagged, so the candidates
+    // are measured in place in the result, one buffer written once (growing it by push_back
+    // and measuring through a chunk buffer touched three times the memory, in fresh pages).
+    flagged.resize(candidates.size());
+    parallel_for(static_cast<std::ptrdiff_t>(candidates.size()), [&](std::ptrdiff_t k) {
+      flagged[static_cast<std::size_t>(k)] = measure(candidates[static_cast<std::size_t>(k)]);
+    });
+    std::erase_if(flagged, [&](const ContactPair& pair) { return !(pair.points.distance <= d_try); });
+  } else {
+    detail::measure_candidates(candidates, measure, [&](const BodyPair&, ContactPair& pair) {
+      if (pair.points.distance <= d_try) flagged.push_back(std::move(pair));
+    });
+  }
   return flagged;
 }
 

@@ -314,7 +314,7 @@ class ContactStep {
     if (!(problem.d_try_multiplier >= 1.0))
       fail_argument("d_try_multiplier", "must be >= 1, got " + std::to_string(problem.d_try_multiplier));
     // Contact free: no pair with d^P < 0 among those with d^P <= 0 (a narrow broad phase).
-    std::vector<ContactPair> touching = find_contact_pairs(problem.shapes, problem.poses, 0.0, problem.box);
+    std::vector<ContactPair> touching = find_contact_pairs(problem.shapes, problem.poses, 0.0, problem.box, &cells_);
     const auto deepest = std::min_element(touching.begin(), touching.end(), [](const auto& a, const auto& b) {
       return a.points.distance < b.points.distance;
     });
@@ -340,7 +340,7 @@ class ContactStep {
     const std::span<const Pose> trial(trial_);
     if (d_try_ == 0.0 && problem.d_try_rule == DTryRule::relative) {
       RelativePairs found = find_pairs_relative(problem.shapes, trial, problem.U, dofs_, problem.dt, problem.d_hat,
-                                                problem.d_try_multiplier, problem.box);
+                                                problem.d_try_multiplier, problem.box, &cells_);
       pairs_ = std::move(found.pairs);
       // One value where one is needed (the barrier's eps_reg, the d^S node threshold): the largest.
       d_try_ = problem.d_try_multiplier * problem.d_hat;
@@ -350,7 +350,7 @@ class ContactStep {
         d_try_ = dofs_ == 3 ? d_try_spheres(problem.d_hat, problem.dt, problem.U, 3, problem.d_try_multiplier)
                             : d_try_tip_velocity(problem.d_hat, problem.dt, problem.shapes, problem.poses, problem.U,
                                                  problem.d_try_multiplier);
-      pairs_ = find_contact_pairs(problem.shapes, trial, d_try_, problem.box);
+      pairs_ = find_contact_pairs(problem.shapes, trial, d_try_, problem.box, &cells_);
     }
     if (cost_ == MobilityCost::automatic)
       cost_ = pairs_.size() <= options.automatic_formed_max_pairs ? MobilityCost::formed : MobilityCost::matrix_free;
@@ -429,13 +429,25 @@ class ContactStep {
 
   // M D lambda: free for lambda = 0, for formed columns and with blocks, else one application.
   VecX MD_times(const VecX& lambda) {
-    if (lambda.isZero(0.0)) return VecX::Zero(mobility_.size());
-    if (cost_ == MobilityCost::blocks) return MD_ * lambda;
-    if (cost_ == MobilityCost::matrix_free) return mobility_.apply(VecX(D_ * lambda));
-    VecX out = VecX::Zero(mobility_.size());
-    for (Eigen::Index k = 0; k < lambda.size(); ++k)
-      if (lambda(k) != 0.0) out += lambda(k) * formed_column(k);
+    VecX out;
+    MD_times(lambda, out);
     return out;
+  }
+
+  // The same into `out`, whose storage is kept when it has the size already.
+  void MD_times(const VecX& lambda, VecX& out) {
+    out.resize(mobility_.size());
+    if (lambda.isZero(0.0)) {
+      out.setZero();
+    } else if (cost_ == MobilityCost::blocks) {
+      out.noalias() = MD_ * lambda;
+    } else if (cost_ == MobilityCost::matrix_free) {
+      out = mobility_.apply(VecX(D_ * lambda));
+    } else {
+      out.setZero();
+      for (Eigen::Index k = 0; k < lambda.size(); ++k)
+        if (lambda(k) != 0.0) out += lambda(k) * formed_column(k);
+    }
   }
 
   // (M D)^T v = D^T M v (M symmetric): free once formed, else one application.
@@ -451,61 +463,64 @@ class ContactStep {
   // A x = dt D^T M D x, the LCP matrix about Q* (eq. 26 with d^P): one application, or free when formed.
   VecX A_times(const VecX& x) { return problem_.dt * (D_.transpose() * MD_times(x)); }
 
-  // Q(lambda) and the flagged-pair distances there; the last evaluation is cached.
+  // Q(lambda) and the flagged-pair distances there; the last evaluation is cached. The next
+  // evaluation of another lambda reuses its storage (a reference returned before is then
+  // the new evaluation): an evaluation of N bodies and Nc pairs touches no fresh memory, which
+  // at 1e6 spheres (56 MB of poses, 100 MB of pairs) was most of the step's time in page faults.
   const ContactEvaluation& evaluate(const VecX& lambda) {
-    if (last_ && last_->lambda.size() == lambda.size() && last_->lambda == lambda) return *last_;
-    ContactEvaluation e = measure(MD_times(lambda));
-    e.lambda = lambda;
-    last_ = std::move(e);
-    return *last_;
+    if (last_valid_ && last_.lambda.size() == lambda.size() && last_.lambda == lambda) return last_;
+    last_valid_ = false;
+    MD_times(lambda, last_.MD_lambda);
+    measure_into(last_);
+    last_.lambda = lambda;
+    last_valid_ = true;
+    return last_;
   }
 
   // Q with velocities U + MD_lambda (M D lambda already known, e.g. scaled along a ray) and
   // the flagged pairs measured there, as evaluate() does (carried contacts by their gap);
   // no mobility application, nothing cached. `lambda` is left empty.
-  // A body on which M D lambda is exactly zero (every body outside the pushed pairs of a local
-  // model such as free draining) moves as in the trial step: it keeps its pose at Q*, and a
-  // pair of two such bodies its measurement at Q* (at_trial_), the same numbers as computing
-  // them again. So an evaluation costs O(N) copies plus the pairs near pushed bodies.
   ContactEvaluation measure(VecX MD_lambda) const {
     ContactEvaluation e;
     e.MD_lambda = std::move(MD_lambda);
-    const VecX V = problem_.U + e.MD_lambda;
-    const auto n = problem_.poses.size();
-    std::vector<char> moved(n, 0);
-    e.poses = trial_;
-    parallel_for(static_cast<std::ptrdiff_t>(n), [&](std::ptrdiff_t body) {
+    measure_into(e);
+    return e;
+  }
+
+  // measure() into e, whose MD_lambda is set and whose other buffers are reused.
+  // A body on which M D lambda is exactly zero (every body outside the pushed pairs of a local
+  // model such as free draining) moves as in the trial step: it keeps its pose at Q*, and a
+  // pair of two such bodies its measurement at Q* (pairs_), the same numbers as computing
+  // them again. So an evaluation costs O(N) copies plus the pairs near pushed bodies.
+  void measure_into(ContactEvaluation& e) const {
+    const VecX& V = velocities(e.MD_lambda);
+    const std::vector<char>& moved = mark_moved(e.MD_lambda);
+    e.poses.assign(trial_.begin(), trial_.end());
+    parallel_for(static_cast<std::ptrdiff_t>(trial_.size()), [&](std::ptrdiff_t body) {
       const auto b = static_cast<std::size_t>(body);
-      const Eigen::Index row = body * dofs_;
-      if (e.MD_lambda.segment(row, dofs_).isZero(0.0)) return;
-      moved[b] = 1;
-      e.poses[b] = advanced(b, V);
+      if (moved[b]) e.poses[b] = advanced(b, V);
     });
     e.pairs.resize(pairs_.size());
     e.distances.resize(nc());
     parallel_for(nc(), [&](std::ptrdiff_t index) {
       const auto k = static_cast<std::size_t>(index);
-      e.pairs[k] = kept_at_trial(k, moved) ? at_trial_[k] : pair_at(k, V, std::span<const Pose>(e.poses));
+      e.pairs[k] = kept_at_trial(k, moved) ? pairs_[k] : pair_at(k, V, std::span<const Pose>(e.poses));
       e.distances(index) = e.pairs[k].points.distance;
     });
-    return e;
   }
 
   // measure(MD_lambda).min_distance(), the same number, without forming Q: the bodies that
   // move are advanced in a configuration kept equal to Q* between calls (and put back), and
   // only their pairs are measured again. O(N) reads and O(pairs of moved bodies) distances,
-  // no O(N) or O(Nc) copies: the cost of a sample of a ray search (defect_correction.hpp).
+  // no O(N) or O(Nc) copies or allocations: the cost of a sample of a ray search
+  // (defect_correction.hpp).
   double min_distance_at(const VecX& MD_lambda) const {
     if (nc() == 0) return std::numeric_limits<double>::infinity();
-    const VecX V = problem_.U + MD_lambda;
-    const auto n = problem_.poses.size();
-    std::vector<char> moved(n, 0);
-    std::vector<std::size_t> moved_bodies;
-    for (std::size_t b = 0; b < n; ++b)
-      if (!MD_lambda.segment(static_cast<Eigen::Index>(b) * dofs_, dofs_).isZero(0.0)) {
-        moved[b] = 1;
-        moved_bodies.push_back(b);
-      }
+    const VecX& V = velocities(MD_lambda);
+    const std::vector<char>& moved = mark_moved(MD_lambda);
+    moved_bodies_.clear();
+    for (std::size_t b = 0; b < moved.size(); ++b)
+      if (moved[b]) moved_bodies_.push_back(b);
     struct PutBack {  // Q* again, also when a measurement throws
       std::vector<Pose>& poses;
       const std::vector<Pose>& trial;
@@ -513,18 +528,19 @@ class ContactStep {
       ~PutBack() {
         for (std::size_t b : bodies) poses[b] = trial[b];
       }
-    } put_back{scratch_poses_, trial_, moved_bodies};
-    parallel_for(static_cast<std::ptrdiff_t>(moved_bodies.size()), [&](std::ptrdiff_t m) {
-      const std::size_t b = moved_bodies[static_cast<std::size_t>(m)];
+    } put_back{scratch_poses_, trial_, moved_bodies_};
+    parallel_for(static_cast<std::ptrdiff_t>(moved_bodies_.size()), [&](std::ptrdiff_t m) {
+      const std::size_t b = moved_bodies_[static_cast<std::size_t>(m)];
       scratch_poses_[b] = advanced(b, V);
     });
-    VecX distances(nc());
+    scratch_distances_.resize(nc());
     parallel_for(nc(), [&](std::ptrdiff_t index) {
       const auto k = static_cast<std::size_t>(index);
-      distances(index) = kept_at_trial(k, moved) ? at_trial_[k].points.distance
-                                                 : pair_at(k, V, std::span<const Pose>(scratch_poses_)).points.distance;
+      scratch_distances_(index) =
+          kept_at_trial(k, moved) ? pairs_[k].points.distance
+                                  : pair_at(k, V, std::span<const Pose>(scratch_poses_)).points.distance;
     });
-    return distances.minCoeff();
+    return scratch_distances_.minCoeff();
   }
 
   // The contact matrix of the flagged pairs at an evaluated configuration: D_k, with
@@ -568,6 +584,15 @@ class ContactStep {
   MobilityCost cost() const { return cost_; }  // the mode in use (automatic resolved)
   const std::vector<ContactColumn>& columns() const { return columns_; }  // D's, one per pair
   const std::vector<ContactPair>& pairs() const { return pairs_; }
+  // The broad phase's buffers, shared by every query of the step (detection, the end check,
+  // the whole-step check): at 1e6 bodies each query's own would be ~100 MB of fresh pages.
+  CellList& cells() const { return cells_; }
+  // The flagged pairs, D's columns and Q of the last evaluation, moved out of a step that is
+  // finished (nothing else may be called on it after): a result keeps them without a copy,
+  // which at 1e6 spheres was 250 MB of fresh memory per step.
+  std::vector<ContactPair> release_pairs() && { return std::move(pairs_); }
+  std::vector<ContactColumn> release_columns() && { return std::move(columns_); }
+  std::vector<Pose> release_last_poses() && { return std::move(last_.poses); }
   const ContactStepProblem<S>& problem() const { return problem_; }
   const ContactStepOptions& options() const { return options_; }
   double d_try() const { return d_try_; }
@@ -582,18 +607,15 @@ class ContactStep {
   // on its carried pair, whose two forces act at one point, the middle of the carried
   // points, so that the column keeps Newton's third law for torques too).
   void rebuild() {
-    last_.reset();
+    last_valid_ = false;  // its buffers are kept for the next evaluation
     const std::span<const Pose> trial(trial_);
     std::optional<BarrierParameters> weight_barrier;
     if (!nodes_.empty()) weight_barrier = detail::surface_weight_barrier(d_try_, options_.surface_weights);
     const std::size_t built = columns_.size();
     columns_.resize(pairs_.size());
-    at_trial_.resize(pairs_.size());
     parallel_for(static_cast<std::ptrdiff_t>(pairs_.size() - built), [&](std::ptrdiff_t index) {
       const std::size_t k = built + static_cast<std::size_t>(index);
       const ContactPair& p = pairs_[k];
-      // carried pairs are measured by their gap instead
-      at_trial_[k] = carried_[k] ? p : remeasured(p, problem_.shapes, trial, problem_.box);
       const std::string field = "pairs[" + std::to_string(k) + "]";
       if (carried_[k] && carried_[k]->interior) {
         columns_[k] = interior_column(*carried_[k], p, problem_.U);
@@ -705,6 +727,22 @@ class ContactStep {
     return column;
   }
 
+  // U + MD_lambda in a buffer kept between calls (valid until the next call).
+  const VecX& velocities(const VecX& MD_lambda) const {
+    scratch_velocities_.resize(problem_.U.size());
+    scratch_velocities_.noalias() = problem_.U + MD_lambda;
+    return scratch_velocities_;
+  }
+
+  // Per body, whether M D lambda moves it (nonzero in its rows); a buffer kept between calls.
+  const std::vector<char>& mark_moved(const VecX& MD_lambda) const {
+    moved_.resize(trial_.size());
+    parallel_for(static_cast<std::ptrdiff_t>(trial_.size()), [&](std::ptrdiff_t body) {
+      moved_[static_cast<std::size_t>(body)] = !MD_lambda.segment(body * dofs_, dofs_).isZero(0.0);
+    });
+    return moved_;
+  }
+
   // Body b at the end of the step with velocities V (eq. 13).
   Pose advanced(std::size_t b, const VecX& V) const {
     const Eigen::Index row = static_cast<Eigen::Index>(b) * dofs_;
@@ -712,11 +750,12 @@ class ContactStep {
     return advance(problem_.poses[b], V.segment<3>(row), omega, problem_.dt);
   }
 
-  // Whether pair k keeps its measurement at Q* (at_trial_) when the bodies marked in `moved`
-  // have left their trial poses: neither of its bodies moved, and it is not carried.
+  // Whether pair k keeps its measurement at Q* (pairs_[k], measured there) when the bodies
+  // marked in `moved` have left their trial poses: neither of its bodies moved, and it is not
+  // carried.
   bool kept_at_trial(std::size_t k, const std::vector<char>& moved) const {
     const ContactPair& p = pairs_[k];
-    return !carried_[k] && k < at_trial_.size() && !moved[static_cast<std::size_t>(p.i)] &&
+    return !carried_[k] && !moved[static_cast<std::size_t>(p.i)] &&
            !moved[static_cast<std::size_t>(p.j)];
   }
 
@@ -749,6 +788,11 @@ class ContactStep {
   std::vector<Pose> trial_;  // Q*
   // Q* again, in which min_distance_at moves bodies for one call and then puts them back.
   mutable std::vector<Pose> scratch_poses_;
+  // Buffers of measure_into and min_distance_at, kept so that repeated evaluations of one step
+  // touch no fresh memory.
+  mutable VecX scratch_velocities_, scratch_distances_;
+  mutable std::vector<char> moved_;
+  mutable std::vector<std::size_t> moved_bodies_;
   std::vector<ContactPair> pairs_;                    // carried ones: their carried pair at Q*
   std::vector<std::optional<CarriedContact>> carried_;  // per pair: carried or not
   std::vector<SurfaceNodes> nodes_;  // per shape, for d^S directions (empty: d^P)
@@ -756,9 +800,10 @@ class ContactStep {
   std::vector<ContactColumn> columns_;  // D_'s columns
   std::vector<VecX> MD_columns_;  // the columns of M D formed so far (empty: not yet)
   MobilityCost cost_ = MobilityCost::formed;
-  std::vector<ContactPair> at_trial_;  // per pair: remeasured at Q* (measure's unmoved pairs)
   Eigen::SparseMatrix<double> M_blocks_, MD_;  // blocks mode: M at Q_t and M D
-  std::optional<ContactEvaluation> last_;
+  mutable CellList cells_;
+  ContactEvaluation last_;  // the last evaluation, when last_valid_
+  bool last_valid_ = false;
 };
 
 namespace detail {
@@ -823,7 +868,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
     const double bound = step.min_distance_bound(e);
     const double below = problem.d_hat * (1.0 - options.separation_margin);
     const double reach = std::max(below, std::min(bound, step.d_try()));
-    violating = find_contact_pairs(problem.shapes, std::span<const Pose>(e.poses), reach, problem.box);
+    violating = find_contact_pairs(problem.shapes, std::span<const Pose>(e.poses), reach, problem.box, &step.cells());
     end_minimum = std::numeric_limits<double>::quiet_NaN();
     if (bound <= reach) {  // (bound is a pair's distance too, should rounding drop it at the cutoff)
       end_minimum = bound;
@@ -835,7 +880,8 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
     if (options.whole_step) {
       try {
         crossing = trajectory_crossings(problem.shapes, problem.poses, V, step.dofs_per_body(), problem.dt,
-                                        -options.separation_margin * problem.d_hat, overlap_tolerance, problem.box);
+                                        -options.separation_margin * problem.d_hat, overlap_tolerance, problem.box,
+                                        &step.cells());
       } catch (const MotionBeyondBox& e) {  // forces that fling a body: not a motion to check or keep
         beyond_box = e.what();
         break;
@@ -854,16 +900,13 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   }
   const ContactEvaluation& e = step.evaluate(outcome.lambda);
   r.lambda = outcome.lambda;
-  r.pairs = step.pairs();
-  r.flagged_pairs = r.pairs.size();
+  r.flagged_pairs = static_cast<std::size_t>(step.nc());
   r.carried_pairs = step.carried_count();
   r.contact_forces = step.D() * r.lambda;
-  r.columns = step.columns();
   r.velocities = problem.U + e.MD_lambda;
-  r.poses = e.poses;
   r.d_try = step.d_try();
   if (std::isnan(end_minimum))  // the end query did not reach it (no flagged pair below d_try)
-    end_minimum = minimum_pair_distance(problem.shapes, std::span<const Pose>(r.poses), problem.box, nullptr,
+    end_minimum = minimum_pair_distance(problem.shapes, std::span<const Pose>(e.poses), problem.box, &step.cells(),
                                         step.min_distance_bound(e))
                       .distance;
   r.min_distance_ratio = end_minimum / problem.d_hat;
@@ -900,6 +943,9 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
     r.status = outcome.converged ? ContactStepStatus::converged : ContactStepStatus::not_converged;
     r.message = outcome.message;
   }
+  r.pairs = std::move(step).release_pairs();  // the step is finished: e is not used below
+  r.columns = std::move(step).release_columns();
+  r.poses = std::move(step).release_last_poses();
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -185,6 +185,24 @@ ClosestPoints closest_points(const CentreCurve<NSA, NAA>& a, double radius_a,
                         detail::reference_centre(a), detail::reference_centre(b));
 }
 
+namespace detail {
+
+// d^P of two shapes at poses the caller has validated (validate_scene, or poses made by
+// advance from valid ones): the contact step measures each flagged pair several times per
+// correction, and four validations per measurement were 9% of a 1e5-sphere step.
+template <Shape A, Shape B>
+ClosestPoints closest_points_of_valid(const A& a, const Pose& pose_a, const B& b, const Pose& pose_b) {
+  CurveContact c;
+  if constexpr (std::is_same_v<A, Sphere> && std::is_same_v<B, Sphere>) {
+    c.points = {0.0, 0.0, pose_a.x, pose_b.x, (pose_b.x - pose_a.x).norm()};
+  } else {
+    c = curve_contact(world_curve(a, pose_a), world_curve(b, pose_b));
+  }
+  return finish(c, a.radius, b.radius, pose_a.x, pose_b.x);
+}
+
+}  // namespace detail
+
 // d^P of two shapes at their poses. Throws std::invalid_argument naming the shape field or
 // "pose_a" / "pose_b". Two spheres compare centres directly; a sphere against another shape
 // is a point against its curve (closed form per piece, no arc search).
@@ -194,13 +212,7 @@ ClosestPoints closest_points(const A& a, const Pose& pose_a, const B& b, const P
   validate(b);
   validate(pose_a, "pose_a");
   validate(pose_b, "pose_b");
-  detail::CurveContact c;
-  if constexpr (std::is_same_v<A, Sphere> && std::is_same_v<B, Sphere>) {
-    c.points = {0.0, 0.0, pose_a.x, pose_b.x, (pose_b.x - pose_a.x).norm()};
-  } else {
-    c = detail::curve_contact(detail::world_curve(a, pose_a), detail::world_curve(b, pose_b));
-  }
-  return detail::finish(c, a.radius, b.radius, pose_a.x, pose_b.x);
+  return detail::closest_points_of_valid(a, pose_a, b, pose_b);
 }
 
 }  // namespace stokescontact

@@ -244,6 +244,12 @@ struct ForceRay {
 
   VecX lambda(double s) const { return base + s * direction; }
   VecX MD(double s) const { return MD_base + s * MD_direction; }
+  // M D lambda(s) into `out`, whose storage is kept when it has the size already.
+  const VecX& MD(double s, VecX& out) const {
+    out.resize(MD_base.size());
+    out.noalias() = MD_base + s * MD_direction;
+    return out;
+  }
   static ForceRay through(const VecX& lambda, const VecX& MD_lambda) {
     return {VecX::Zero(lambda.size()), lambda, VecX::Zero(MD_lambda.size()), MD_lambda};
   }
@@ -256,7 +262,8 @@ struct ForceRay {
 template <Shape S, MobilityOperator M>
 std::optional<double> ray_first_crossing(const ContactStep<S, M>& step, const ForceRay& ray, double s_max,
                                          double target, int samples, double tol) {
-  const auto separated = [&](double s) { return min_flagged_distance_at(step, ray.MD(s)) >= target; };
+  VecX MD;  // one buffer for every sample: at 1e6 spheres a fresh one is 24 MB of new pages
+  const auto separated = [&](double s) { return min_flagged_distance_at(step, ray.MD(s, MD)) >= target; };
   double lo = 0.0, hi = -1.0;
   for (int j = 1; j <= samples; ++j) {
     const double s = s_max * j / samples;
