@@ -148,13 +148,13 @@ TEST(BarrierWorkingSet, ModelProblemIsTheSmallestSumOrDissipation) {
   for (const nlopt::algorithm algorithm : {nlopt::LD_SLSQP, nlopt::LD_MMA}) {
     SCOPED_TRACE(algorithm == nlopt::LD_SLSQP ? "slsqp" : "mma");
     sc::detail::WorkingSetBarrier sum{algorithm, false};
-    const auto y = sum(A, W, zero, zero, 1.0, 0);
+    const auto y = sum(A, W, zero, zero, 1.0, {});
     ASSERT_TRUE(y.has_value());
     EXPECT_NEAR((*y - sc::Vec3(0.0, 5.0 / 3.0, 0.0)).norm(), 0.0, 1e-6) << y->transpose();
     const sc::VecX separation = A * *y;  // (a named product: GCC 12 misreads the temporary as used after free)
     EXPECT_GE(separation.minCoeff(), 1.0 - 1e-6);
     sc::detail::WorkingSetBarrier dissipation{algorithm, true};
-    const auto z = dissipation(A, W, zero, zero, 1.0, 0);
+    const auto z = dissipation(A, W, zero, zero, 1.0, {});
     ASSERT_TRUE(z.has_value());
     EXPECT_NEAR((*z - sc::Vec3(1.0, 0.0, 1.0)).norm(), 0.0, 1e-6) << z->transpose();
   }
@@ -165,7 +165,7 @@ TEST(BarrierWorkingSet, ModelProblemIsTheSmallestSumOrDissipation) {
   expect_rejects([&] { mma.validate(); }, "BarrierNloptOptions.optimizer");
   // Nothing below the target: no force, no NLopt call.
   sc::detail::WorkingSetBarrier sum;
-  const auto none = sum(A, W, zero, sc::VecX::Constant(3, 2.0), 1.0, 0);
+  const auto none = sum(A, W, zero, sc::VecX::Constant(3, 2.0), 1.0, {});
   ASSERT_TRUE(none.has_value());
   EXPECT_EQ(none->norm(), 0.0);
 }

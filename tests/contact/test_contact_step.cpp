@@ -452,6 +452,37 @@ TEST(ContactStep, JammedClusterIsSeparatedByTheWorkingSetBarrier) {
   }
 }
 
+// Inexact corrections (DefectCorrectionOptions::lcp_forcing: each working-set LCP solved only
+// to a tolerance that follows the corrections' convergence) against every LCP solved to 1e-12,
+// on a jammed packing whose working set is one cluster of hundreds of pairs: both separated
+// and complementary, the same force within the corrections' stopping rule.
+TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
+  std::mt19937_64 rng(11);
+  const sc::SpherePacking packing = sc::dense_packing(300, 0.6, rng());
+  const std::vector<sc::Vec3> forces = sc::random_forces(300, 100.0, rng);
+  SphereScene s;
+  s.poses = packing.poses;
+  s.d_hat = 1e-4;
+  s.dt = 0.01;
+  s.U.resize(900);
+  for (std::size_t i = 0; i < 300; ++i) s.U.segment<3>(3 * static_cast<Eigen::Index>(i)) = kMu * forces[i];
+  sc::DefectCorrectionOptions exact;
+  exact.lcp_forcing = 0.0;
+  auto m0 = s.mobility();
+  auto m1 = s.mobility();
+  const sc::ContactStepResult inexact = sc::solve_contact_step_defect_correction(s.problem(), m0);
+  const sc::ContactStepResult reference = sc::solve_contact_step_defect_correction(s.problem(), m1, {}, exact);
+  ASSERT_GE((reference.lambda.array() > 0.0).count(), 100);  // a network, not a few pairs
+  for (const sc::ContactStepResult* r : {&inexact, &reference}) {
+    EXPECT_EQ(r->status, sc::ContactStepStatus::converged) << r->message;
+    EXPECT_GE(r->min_distance_ratio, 1.0);
+    EXPECT_LE(r->complementarity_residual, 1e-3);
+  }
+  ASSERT_EQ(inexact.lambda.size(), reference.lambda.size());
+  EXPECT_LE((inexact.lambda - reference.lambda).lpNorm<Eigen::Infinity>(), 1e-3 * reference.lambda_max);
+  EXPECT_NEAR(inexact.lambda_sum, reference.lambda_sum, kDefaultLambdaTolerance * reference.lambda_sum);
+}
+
 // The cost mode follows the model: blocks for a block-diagonal one (free draining); for any
 // other, formed up to automatic_formed_max_pairs flagged pairs and matrix_free beyond. blocks
 // asked of a model without blocks is refused, naming the option.
@@ -539,6 +570,12 @@ TEST(ContactStep, RejectsBadInputNamingTheFieldAndChangesNothing) {
   sc::DefectCorrectionOptions def;
   def.probe_radius_factor = 0.0;
   expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(p, m, {}, def); }, "DefectCorrectionOptions.probe_radius_factor");
+  def = {};
+  def.lcp_forcing = -1.0;
+  expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(p, m, {}, def); }, "DefectCorrectionOptions.lcp_forcing");
+  def = {};
+  def.lcp_tolerance_max = 1e-13;  // below lcp.tolerance
+  expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(p, m, {}, def); }, "DefectCorrectionOptions.lcp_tolerance_max");
   sc::FreeDrainingMobility wrong(sc::sphere_mobility(sc::Sphere{1.0}, 1.0), 3, 3);  // 3 bodies for 2 poses
   expect_rejects([&] { (void)sc::solve_contact_step_lcp_sequence(p, wrong); }, "mobility");
   EXPECT_EQ(m.applications(), 0u);

@@ -230,6 +230,7 @@ ContactStepResult solve_contact_step_barrier(const ContactStepProblem<S>& proble
   if (barrier.constraint == BarrierConstraint::working_set) {
     DefectCorrectionOptions corrections;
     corrections.tol = barrier.tol;
+    corrections.lcp_forcing = 0.0;  // every LCP to 1e-12: its answer starts SLSQP, whose dense solve is the cost
     const detail::WorkingSetBarrier subproblem{detail::nlopt_algorithm(barrier.optimizer),
                                                barrier.objective == BarrierObjective::dissipation,
                                                barrier.max_evaluations, corrections.lcp};

@@ -56,7 +56,7 @@ struct WorkingSetBarrier {
   nlopt::algorithm algorithm = nlopt::LD_SLSQP;
   bool dissipation = false;  // objective y^T A~ y (eq. 14 with M), else sum y
   int max_evaluations = 1000;
-  LcpOptions lcp{1e-12};
+  LcpOptions lcp{1e-12};  // the start's LCP (its tolerance the correction's)
   std::string_view name = "barrier (working set)";
 
   int smallest_sum_corrections = 10;  // corrections that pose eq. 15; the LCP after them
@@ -64,10 +64,12 @@ struct WorkingSetBarrier {
 
   template <LcpMatrixOperator Model>
   std::optional<VecX> operator()(const Model& A, std::span<const Eigen::Index> W, const VecX& lambda,
-                                 const VecX& distances, double target, int correction) const {
-    std::optional<VecX> start = solve_working_set_lcp(A, W, lambda, distances, target, lcp);
+                                 const VecX& distances, double target, const Correction& correction) const {
+    LcpOptions inexact = lcp;
+    inexact.tolerance = correction.lcp_tolerance;
+    std::optional<VecX> start = solve_working_set_lcp(A, W, lambda, distances, target, inexact);
     if (!start) return std::nullopt;
-    if (correction >= smallest_sum_corrections) {
+    if (correction.number >= smallest_sum_corrections) {
       ++complementarity_corrections;
       return start;
     }
