@@ -56,7 +56,8 @@ std::string record(const char* part, const std::string& solver, const sc::Contac
          std::to_string(r.iterations) + ", \"wall_time_s\": " + sc::json_number(r.wall_time_s) +
          ", \"min_d_over_d_hat_after\": " + sc::json_number(r.min_distance_ratio) +
          ", \"complementarity_residual\": " + sc::json_number(r.complementarity_residual) + ", \"lambda_sum\": " +
-         sc::json_number(r.lambda_sum) + ", \"status\": \"" + std::string(sc::to_string(r.status)) + "\"";
+         sc::json_number(r.lambda_sum) + ", \"status\": \"" + std::string(sc::to_string(r.status)) + "\"" +
+         ", \"message\": " + sc::json_quoted(r.message);
 }
 
 bool ball(ex::JsonLines& sink, std::size_t n, int steps, sc::MobilityCost mode) {

@@ -2,9 +2,11 @@
 // multisecant correction (secant_update.hpp) against its defining conditions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "common/test_support.hpp"
@@ -274,6 +276,75 @@ TEST(DefaultSolver, SqueezedLatticeIsSeparatedAtComplementarity) {
   EXPECT_LE(def.complementarity_residual, 1e-3);
   EXPECT_EQ(lcp.status, sc::ContactStepStatus::converged) << lcp.message;
   EXPECT_LE(def.lambda_sum, lcp.lambda_sum * (1.0 + 1e-3));
+}
+
+
+// The probed model on the working set W embedded among all flagged pairs, as the LCP sequence
+// that finishes a round takes it: W's entries at W's positions (brute force, entry by entry),
+// every other pair alone on its row with the mean of W's diagonal.
+TEST(DefaultSolver, ModelOnFlaggedPairsKeepsTheWorkingSetsEntries) {
+  sc::MatX model(3, 3);
+  model << 4, -1, 0, -1, 5, -2, 0, -2, 6;
+  const Eigen::SparseMatrix<double> sparse = model.sparseView();
+  const std::vector<Eigen::Index> W{5, 1, 3};
+  const sc::MatX embedded(sc::detail::model_on_flagged_pairs(sparse, W, 7));
+  for (Eigen::Index r = 0; r < 7; ++r)
+    for (Eigen::Index c = 0; c < 7; ++c) {
+      const auto in_W = [&](Eigen::Index k) { return std::find(W.begin(), W.end(), k) - W.begin(); };
+      const auto i = in_W(r), j = in_W(c);
+      const double expected = i < 3 && j < 3 ? model(i, j) : (r == c ? 5.0 : 0.0);
+      EXPECT_EQ(embedded(r, c), expected) << r << ", " << c;
+    }
+  try {
+    sc::detail::model_on_flagged_pairs(sparse, std::vector<Eigen::Index>{0, 1}, 7);
+    ADD_FAILURE() << "a model of the wrong size was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("model"), std::string::npos) << e.what();
+  }
+}
+
+// A jammed packing in matrix-free mode, where probes are shared and the corrections do not
+// contract: the round is finished by the LCP sequence with exact products, whose Newton starts
+// from and is preconditioned by the probed model. It must give the blocks mode's answer
+// (exact model, no fallback) and cost fewer applications than the LCP sequence alone, polished
+// to complementarity the same way.
+TEST(DefaultSolver, JammedMatrixFreeRoundIsFinishedFromTheProbedModel) {
+  constexpr std::size_t n = 300;
+  std::mt19937_64 rng(11);
+  const sc::SpherePacking packing = sc::dense_packing(n, 0.6, rng());
+  const std::vector<sc::Vec3> forces = sc::random_forces(n, 100.0, rng);
+  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  const auto mobility = [&] {
+    sc::FreeDrainingMobility m(sc::sphere_mobility(shapes[0], 1.0), n, 3);
+    m.set_configuration(packing.poses);
+    return m;
+  };
+  sc::VecX F(3 * static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) F.segment<3>(3 * static_cast<Eigen::Index>(i)) = forces[i];
+  auto m0 = mobility();
+  const sc::ContactStepProblem<sc::Sphere> p{shapes, packing.poses, m0.apply(F), 0.01, 1e-4};
+  sc::ContactStepOptions blocks, matrix_free;
+  blocks.cost = sc::MobilityCost::blocks;
+  matrix_free.cost = sc::MobilityCost::matrix_free;
+  auto m1 = mobility(), m2 = mobility(), m3 = mobility();
+  const sc::ContactStepResult exact = sc::solve_contact_step_defect_correction(p, m1, blocks);
+  const sc::ContactStepResult probed = sc::solve_contact_step_defect_correction(p, m2, matrix_free);
+  const sc::DefectCorrectionOptions corrections;
+  sc::LcpSequenceOptions polished;  // to complementarity, as the default solver finishes a round
+  polished.tol = corrections.tol;
+  polished.margin = corrections.margin;
+  const sc::ContactStepResult sequence = sc::solve_contact_step_lcp_sequence(p, m3, matrix_free, polished);
+  std::printf("  jammed %zu spheres: %zu flagged; matrix-free default %zu applications (%s), LCP sequence %zu\n", n,
+              probed.flagged_pairs, probed.mobility_applications, probed.message.c_str(),
+              sequence.mobility_applications);
+  EXPECT_NE(probed.message.find("finished by the LCP sequence"), std::string::npos) << probed.message;
+  for (const sc::ContactStepResult* r : {&exact, &probed}) {
+    EXPECT_EQ(r->status, sc::ContactStepStatus::converged) << r->message;
+    EXPECT_GE(r->min_distance_ratio, 1.0);
+    EXPECT_LE(r->complementarity_residual, 1e-3);
+  }
+  EXPECT_NEAR(probed.lambda_sum, exact.lambda_sum, 1e-4 * exact.lambda_sum);
+  EXPECT_LE(2 * probed.mobility_applications, sequence.mobility_applications);
 }
 
 }  // namespace

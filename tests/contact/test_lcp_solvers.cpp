@@ -18,6 +18,7 @@
 #include "stokescontact/lcp/apgd.hpp"
 #include "stokescontact/lcp/bbpgd.hpp"
 #include "stokescontact/lcp/minimum_map_newton.hpp"
+#include "stokescontact/lcp/model_started_newton.hpp"
 
 // The whole file in its own namespace: tests of one layer are compiled together (unity build).
 namespace lcp_solvers_tests {
@@ -483,32 +484,43 @@ TEST(LcpSolvers, LargeSparseProblemAllThreeAgree) {
 // neighbours, free draining with M = I, every pair pushed together by a force towards the
 // lattice's centre line: A = D^T D is the edge Laplacian of the lattice (condition ~1e4, as
 // the Delassus matrix of one large connected cluster), b < 0 on most pairs.
+struct LatticeCluster {
+  SparseMat A;
+  sc::VecX b;
+  LatticeCluster() {
+    constexpr Eigen::Index nx = 30, ny = 100;
+    const auto body = [&](Eigen::Index x, Eigen::Index y) { return x + nx * y; };
+    std::vector<Eigen::Triplet<double>> entries;
+    std::vector<double> push;
+    Eigen::Index c = 0;
+    for (Eigen::Index y = 0; y < ny; ++y)
+      for (Eigen::Index x = 0; x < nx; ++x)
+        for (const auto& [dx, dy] : {std::pair<Eigen::Index, Eigen::Index>{1, 0}, {0, 1}}) {
+          if (x + dx >= nx || y + dy >= ny) continue;
+          const Eigen::Index i = body(x, y), j = body(x + dx, y + dy), axis = dx == 1 ? 0 : 1;
+          entries.emplace_back(3 * j + axis, c, 1.0);  // the normal from i to j, on j; minus it on i
+          entries.emplace_back(3 * i + axis, c, -1.0);
+          // closing velocity: pairs across the centre line y = ny / 2 are pushed hardest
+          push.push_back(dy == 1 ? -1.0 - 0.01 * static_cast<double>(std::min(y, ny - 1 - y)) : 0.5);
+          ++c;
+        }
+    SparseMat D(3 * nx * ny, c);
+    D.setFromTriplets(entries.begin(), entries.end());
+    A = SparseMat(D.transpose() * D);
+    b = Eigen::Map<const sc::VecX>(push.data(), c);
+  }
+};
+
 // Minimum-map Newton with the sparse matrix itself as its preconditioner (what the default
 // solver's working set passes: its sparse model) takes at most a third of the applications of
 // A that unpreconditioned GMRES takes (measured: 160 against 621, the first 50 Arnoldi steps
 // of each direction being unpreconditioned), for the same solution; an indefinite preconditioner is not used
 // (the same solution at the unpreconditioned cost); one of the wrong size is rejected by name.
 TEST(LcpSolvers, PreconditionedNewtonSolvesALargeClusterInFewApplications) {
-  constexpr Eigen::Index nx = 30, ny = 100;
-  const auto body = [&](Eigen::Index x, Eigen::Index y) { return x + nx * y; };
-  std::vector<Eigen::Triplet<double>> entries;
-  std::vector<double> push;
-  Eigen::Index c = 0;
-  for (Eigen::Index y = 0; y < ny; ++y)
-    for (Eigen::Index x = 0; x < nx; ++x)
-      for (const auto& [dx, dy] : {std::pair<Eigen::Index, Eigen::Index>{1, 0}, {0, 1}}) {
-        if (x + dx >= nx || y + dy >= ny) continue;
-        const Eigen::Index i = body(x, y), j = body(x + dx, y + dy), axis = dx == 1 ? 0 : 1;
-        entries.emplace_back(3 * j + axis, c, 1.0);  // the normal from i to j, on j; minus it on i
-        entries.emplace_back(3 * i + axis, c, -1.0);
-        // closing velocity: pairs across the centre line y = ny / 2 are pushed hardest
-        push.push_back(dy == 1 ? -1.0 - 0.01 * static_cast<double>(std::min(y, ny - 1 - y)) : 0.5);
-        ++c;
-      }
-  SparseMat D(3 * nx * ny, c);
-  D.setFromTriplets(entries.begin(), entries.end());
-  const SparseMat A = SparseMat(D.transpose() * D);
-  const sc::VecX b = Eigen::Map<const sc::VecX>(push.data(), c);
+  const LatticeCluster lattice;
+  const SparseMat& A = lattice.A;
+  const sc::VecX& b = lattice.b;
+  const Eigen::Index c = b.size();
   const sc::LcpOptions options{.tolerance = 1e-8, .max_iterations = 200};
   const sc::LcpResult plain = sc::solve_lcp_minimum_map_newton(A, b, options);
   const sc::LcpResult preconditioned = sc::solve_lcp_minimum_map_newton(A, b, options, nullptr, &A);
@@ -534,6 +546,41 @@ TEST(LcpSolvers, PreconditionedNewtonSolvesALargeClusterInFewApplications) {
     ADD_FAILURE() << "a wrong-size preconditioner was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("preconditioner"), std::string::npos) << e.what();
+  }
+}
+
+// The lattice cluster as the LCP sequence solves it when the default solver hands it a round
+// (model_started_newton.hpp): Newton from BBPGD's start on a sparse model P close to A (A with
+// its off-diagonal entries scaled by 0.9, as a probed model misses part of the coupling) and
+// preconditioned by P from the first Arnoldi step. The same solution as Newton alone, in fewer
+// applications of A than Newton preconditioned by P after 50 unpreconditioned steps.
+TEST(LcpSolvers, NewtonFromAModelsStartSolvesTheClusterInFewerApplications) {
+  const LatticeCluster lattice;
+  const SparseMat& A = lattice.A;
+  const sc::VecX& b = lattice.b;
+  SparseMat P = 0.9 * A;
+  P.diagonal() = A.diagonal();
+  const sc::VecX zero = sc::VecX::Zero(b.size());
+  sc::LcpOptions options{.tolerance = 1e-8, .max_iterations = 200};
+  const sc::LcpResult plain = sc::solve_lcp_minimum_map_newton(A, b, options);
+  const sc::LcpResult later = sc::solve_lcp_minimum_map_newton(A, b, options, &zero, &P);
+  options.gmres_unpreconditioned_steps = 0;
+  const sc::LcpResult started = sc::solve_lcp_newton_from_model(A, b, P, b, options, zero);
+  for (const sc::LcpResult* r : {&plain, &later, &started}) ASSERT_TRUE(r->converged) << r->residual;
+  std::printf("  lattice cluster: %zu applications unpreconditioned, %zu preconditioned after 50 steps, %zu from the "
+              "model's start\n",
+              plain.operator_applications, later.operator_applications, started.operator_applications);
+  EXPECT_LT(started.operator_applications, later.operator_applications);
+  const double scale = std::max(1.0, plain.gamma.cwiseAbs().maxCoeff());
+  EXPECT_LE((started.gamma - plain.gamma).cwiseAbs().maxCoeff(), 1e-6 * scale);
+  EXPECT_LE((later.gamma - plain.gamma).cwiseAbs().maxCoeff(), 1e-6 * scale);
+
+  options.gmres_unpreconditioned_steps = -1;
+  try {
+    options.validate();
+    ADD_FAILURE() << "a negative gmres_unpreconditioned_steps was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("gmres_unpreconditioned_steps"), std::string::npos) << e.what();
   }
 }
 

@@ -39,6 +39,10 @@ struct LcpOptions {
   int gmres_max_iterations = 500;  // Arnoldi steps per Newton direction
   double forcing_max = 0.1;        // GMRES relative tolerance eta_k <= forcing_max (inexact Newton)
   double regularization = 1e-2;    // proximal term mu_k = regularization c |H_k| / |H_0| (0: none)
+  // With a sparse preconditioner: Arnoldi steps a Newton direction takes before its block is
+  // factorised (0: at once, where a product with A costs a mobility application and a sparse
+  // factorisation is cheaper than a few of them).
+  int gmres_unpreconditioned_steps = 50;
   // Newton: Armijo halvings per line search; APGD: doublings of L per step.
   int max_line_search_steps = 40;
 
@@ -52,6 +56,9 @@ struct LcpOptions {
     at_least_one(gmres_max_iterations, "LcpOptions.gmres_max_iterations");
     at_least_one(max_line_search_steps, "LcpOptions.max_line_search_steps");
     require_non_negative(regularization, "LcpOptions.regularization");
+    if (gmres_unpreconditioned_steps < 0)
+      fail_argument("LcpOptions.gmres_unpreconditioned_steps",
+                    "must be >= 0, got " + std::to_string(gmres_unpreconditioned_steps));
     require_positive(forcing_max, "LcpOptions.forcing_max");
     if (!(forcing_max < 1.0)) fail_argument("LcpOptions.forcing_max", "must be < 1, got " + std::to_string(forcing_max));
   }

@@ -15,9 +15,9 @@
 // correction; or A itself) passes it: GMRES is then right-preconditioned by a sparse Cholesky
 // factorisation (Eigen's SimplicialLDLT) of P_AA + mu_k I, so that a large connected cluster,
 // whose A conditions like a graph Laplacian, costs a few Arnoldi steps per direction instead
-// of hundreds. A direction first gets kUnpreconditionedSteps Arnoldi steps without it (a
-// well-conditioned block, e.g. a model lifted by a diagonal shift, converges in those, and a
-// factorisation would cost more than it saves); only then is P_AA + mu_k I factorised, and
+// of hundreds. A direction first gets LcpOptions::gmres_unpreconditioned_steps (50) Arnoldi
+// steps without it (a well-conditioned block, e.g. a model lifted by a diagonal shift,
+// converges in those, and a factorisation would cost more than it saves); only then is P_AA + mu_k I factorised, and
 // GMRES goes on from where it stopped. The factorisation is kept while the set A stays the
 // same (mu_k changes, but a preconditioner need not be exact: GMRES's residual is the true
 // one). Where that block is not positive definite, GMRES runs unpreconditioned. The proximal term
@@ -97,9 +97,6 @@ inline Eigen::SparseMatrix<double> shifted_principal_block(const Eigen::SparseMa
   return block;
 }
 
-// Arnoldi steps a Newton direction takes before its block is factorised as a preconditioner.
-inline constexpr int kUnpreconditionedSteps = 50;
-
 // (P_AA + mu I)^-1 for Newton's GMRES, factorised again only when the set A changes.
 class ActiveBlockPreconditioner {
  public:
@@ -165,9 +162,11 @@ MinimumMapDirection newton_direction(Op& A, const MinimumMapState& s, const VecX
     GmresResult solved;
     if (preconditioner.available() && !preconditioner.factorised_for(active)) {
       GmresOptions quick = gmres_options;
-      quick.max_iterations = std::min(quick.max_iterations, kUnpreconditionedSteps);
-      solved = gmres(A_AA, rhs, quick);
-      if (!solved.converged) {
+      quick.max_iterations = std::min(quick.max_iterations, options.gmres_unpreconditioned_steps);
+      if (quick.max_iterations == 0) {
+        preconditioner.update(active, mu);
+        solved = gmres(A_AA, rhs, preconditioner, gmres_options);
+      } else if (solved = gmres(A_AA, rhs, quick); !solved.converged) {
         preconditioner.update(active, mu);
         const VecX start = solved.x;
         solved = gmres(A_AA, rhs, preconditioner, gmres_options, &start);

@@ -29,6 +29,7 @@
 #include "stokescontact/lcp/apgd.hpp"
 #include "stokescontact/lcp/bbpgd.hpp"
 #include "stokescontact/lcp/minimum_map_newton.hpp"
+#include "stokescontact/lcp/model_started_newton.hpp"
 
 namespace stokescontact {
 
@@ -68,9 +69,14 @@ LcpResult solve_inner_lcp(InnerLcpSolver solver, ApplyA& A, const VecX& b, const
   return {};
 }
 
-// One round of the sequence, from lambda_0 = warm_start.
+// One round of the sequence, from lambda_0 = warm_start. `model`, when given: a sparse
+// symmetric positive definite matrix close to A on all flagged pairs (the default solver's
+// probed model, when it hands a round over); minimum-map Newton then starts each LCP from
+// BBPGD on the model and is preconditioned by it (model_started_newton.hpp), which costs no
+// application of A. The other inner solvers do not use it.
 template <Shape S, MobilityOperator M>
-ContactSolveOutcome solve_lcp_sequence_round(ContactStep<S, M>& step, VecX lambda, const LcpSequenceOptions& options) {
+ContactSolveOutcome solve_lcp_sequence_round(ContactStep<S, M>& step, VecX lambda, const LcpSequenceOptions& options,
+                                             const Eigen::SparseMatrix<double>* model = nullptr) {
   ContactSolveOutcome out;
   const double d_hat = step.problem().d_hat, target = d_hat * (1.0 + options.margin);
   const bool polish = options.tol > 0.0;
@@ -91,7 +97,11 @@ ContactSolveOutcome solve_lcp_sequence_round(ContactStep<S, M>& step, VecX lambd
     ++out.iterations;
     const VecX A_lambda = step.problem().dt * (step.D().transpose() * e.MD_lambda);
     const VecX b = e.distances - VecX::Constant(step.nc(), target) - A_lambda;
-    LcpResult lcp = solve_inner_lcp(options.inner, A, b, options.lcp, lambda);
+    LcpResult lcp =
+        model && options.inner == InnerLcpSolver::minimum_map_newton
+            ? solve_lcp_newton_from_model(A, b, *model, VecX(e.distances - VecX::Constant(step.nc(), target) - *model * lambda),
+                                          options.lcp, lambda)
+            : solve_inner_lcp(options.inner, A, b, options.lcp, lambda);
     if (lcp.gamma == lambda) {  // the LCP has nothing left to change: stalled
       out.message = "LCP sequence stalled after " + std::to_string(out.iterations) + " LCPs, min flagged d / d_hat = " +
                     std::to_string(e.min_distance() / d_hat);
