@@ -26,7 +26,10 @@
 // covariance. --tolerance > 0: ERROR when |Z - Z_CS| > tolerance Z_CS + 3 error bars.
 // A step that fails (TimeStepper throws after its sub-steps) is an ERROR and ends that run.
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/dynamics/time_stepper.hpp>
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/scenes/sphere_packing.hpp>
 
 #include <cmath>
 #include <cstdio>

@@ -43,7 +43,12 @@
 // --tolerance > 0: ERROR when the U0 = 0 ratio is not within tolerance (relative) plus 3 error
 // bars of that series.
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/dynamics/nematic_order.hpp>
+#include <stokescontact/dynamics/time_stepper.hpp>
+#include <stokescontact/io/diagnostics_json.hpp>
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/scenes/periodic_placement.hpp>
 
 #include <chrono>
 #include <cmath>

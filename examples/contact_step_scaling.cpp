@@ -20,7 +20,11 @@
 // process touching its memory for the first time: page faults) is reported as well. The
 // repeats must give the same forces (ERROR otherwise).
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/scenes/random.hpp>
+#include <stokescontact/scenes/sphere_packing.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -18,7 +18,17 @@
 //   whole_step over the free-draining unconstrained step and, for N <= 1e4, over one RPY
 //   application (the unconstrained step with hydrodynamics).
 // One JSON object per line (to --output if given, else stdout) and a readable summary on stdout.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/contact_pairs.hpp>
+#include <stokescontact/contact/continuous_detection.hpp>
+#include <stokescontact/contact/d_try.hpp>
+#include <stokescontact/dynamics/time_stepper.hpp>
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/boomerang_blobs.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/mobility/rpy_mobility.hpp>
+#include <stokescontact/mobility/single_body_mobility.hpp>
+#include <stokescontact/scenes/random.hpp>
+#include <stokescontact/scenes/sphere_packing.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -16,7 +16,11 @@
 //   ~1e-3), random forces |f| = 100, free draining, dt = 0.01, d_hat = 1e-4: one contact step
 //   per solver; pushed pairs, applications, wall time, min d / d_hat after, complementarity.
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/scenes/random.hpp>
+#include <stokescontact/scenes/sphere_packing.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -25,7 +25,8 @@
 // x 1, at TOL 5e-6 (Fig. 5b with the lambda sum, Fig. 6 with --objective dissipation).
 // --objective: eq. 14's norm for the barrier solvers, sum of lambda (the default) or the
 // dissipation lambda^T D^T M D lambda.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/io/json.hpp>
 
 #include <algorithm>
 #include <array>

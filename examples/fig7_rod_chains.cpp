@@ -34,7 +34,12 @@
 // margin 1e-3), and reported as failed separation; d(lambda) against d_hat (Fig. 7b), (d - d_hat) / d_hat before and
 // after (Fig. 7c: min, 10th, 50th, 90th percentile, max), lambda / |f| (Fig. 7d). The paper
 // does not list its d_hat values; the default covers 1e-4 to 1e-1 in half decades.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/contact_pairs.hpp>
+#include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/core/rigid_motion.hpp>
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/rod_blobs.hpp>
+#include <stokescontact/mobility/single_body_mobility.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -27,7 +27,11 @@
 // the symmetric start, to see whether the contacts restore or amplify it.
 // --max-correction-turn: ContactStepOptions::max_correction_turn in radians (a step whose
 // correction turns a rod further is refused and sub-stepped; a large value lifts the guard).
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/contact_pairs.hpp>
+#include <stokescontact/core/rigid_motion.hpp>
+#include <stokescontact/dynamics/nematic_order.hpp>
+#include <stokescontact/dynamics/time_stepper.hpp>
+#include <stokescontact/io/json.hpp>
 
 #include <algorithm>
 #include <array>

@@ -23,7 +23,14 @@
 // surface grids at --spacings) against a finer surface grid (--reference-spacing) taken as
 // the converged value: relative errors of the translation, rotation and coupling blocks
 // (Frobenius norms) and of the whole 6x6 matrix in the units where its blocks are comparable.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/contact_pairs.hpp>
+#include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/boomerang_blobs.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/mobility/multiblob_mobility.hpp>
+#include <stokescontact/mobility/single_body_mobility.hpp>
+#include <stokescontact/scenes/random.hpp>
 
 #include <cstdio>
 #include <optional>

@@ -16,7 +16,8 @@
 //               1 - 1e-9; null when no solve qualifies, or when best = 0 < sum lambda.
 // One JSON object per (scene, config, solver, cost) (to --output, else stdout), then a summary
 // per scene and solver. scripts/plot_speed_vs_error.py plots the JSON.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/io/json.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -6,8 +6,16 @@
 
 #include <stokescontact/core/block_average.hpp>
 #include <stokescontact/dynamics/collision_stress.hpp>
+#include <stokescontact/dynamics/time_stepper.hpp>
 #include <stokescontact/io/diagnostics_json.hpp>
 #include <stokescontact/io/vtk_polydata.hpp>
+#include <stokescontact/mobility/boomerang_blobs.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/mobility/multiblob_mobility.hpp>
+#include <stokescontact/mobility/rod_blobs.hpp>
+#include <stokescontact/mobility/rpy_mobility.hpp>
+#include <stokescontact/mobility/single_body_mobility.hpp>
+#include <stokescontact/mobility/sphere_shell.hpp>
 
 #include "scene/model_choice.hpp"
 #include "scene/output_directory.hpp"

@@ -9,7 +9,11 @@
 #include <variant>
 #include <vector>
 
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/dynamics/background_flow.hpp>
+#include <stokescontact/geometry/line_contact.hpp>
+#include <stokescontact/geometry/shapes.hpp>
+#include <stokescontact/scenes/sphere_packing.hpp>
 
 #include "scene/json_reader.hpp"
 

@@ -4,7 +4,8 @@
 // norms of the translation, rotation and coupling blocks), and of the whole matrix scaled by
 // the body's length scale ell, (u, omega ell) / (f, tau / ell), in which the three blocks are
 // of one size. Shared by fig9_boomerangs --resolution and fig7_rod_chains --resolution.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/core/types.hpp>
+#include <stokescontact/io/json.hpp>
 
 #include <cstddef>
 #include <cstdio>

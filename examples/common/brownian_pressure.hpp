@@ -14,7 +14,9 @@
 // The discrete step misses the collisions a Brownian path makes between the ends of a step, so
 // Z is low by an amount that shrinks like sqrt(dt) (docs/results.md, "Brownian hard spheres");
 // extrapolate_to_zero_step fits Z = Z_0 + c sqrt(dt) through several step sizes.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/core/block_average.hpp>
+#include <stokescontact/dynamics/collision_stress.hpp>
+#include <stokescontact/dynamics/time_stepper.hpp>
 
 #include <algorithm>
 #include <chrono>

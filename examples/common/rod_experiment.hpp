@@ -3,7 +3,11 @@
 // end to end and radius R_rod as a Spherocylinder (centre segment L_rod - 2 R_rod: the
 // paper's boomerang, "a rod of L_rod / R_rod = 8 and R_rod = 0.5", is 4 long end to end, Sec.
 // 3.3.1), the mobility models a rod driver can use, and the contact-direction option.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/contact_step.hpp>
+#include <stokescontact/geometry/line_contact.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/mobility/multiblob_mobility.hpp>
+#include <stokescontact/mobility/rod_blobs.hpp>
 
 #include <cstddef>
 #include <stdexcept>

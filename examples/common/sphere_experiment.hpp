@@ -5,7 +5,16 @@
 // velocities U = M f cost one mobility application, not counted in the contact step; the step
 // itself (dt = 0.01, d^P, d_try of eq. 31 times a multiplier) is run by a contact solver
 // chosen by value (contact_solver_from_name) and summarised in a StepRecord.
-#include <stokescontact/stokescontact.hpp>
+#include <stokescontact/contact/continuous_detection.hpp>
+#include <stokescontact/contact/contact_pairs.hpp>
+#include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/geometry/swept_distance.hpp>
+#include <stokescontact/io/json.hpp>
+#include <stokescontact/mobility/free_draining.hpp>
+#include <stokescontact/mobility/multiblob_mobility.hpp>
+#include <stokescontact/mobility/rpy_mobility.hpp>
+#include <stokescontact/mobility/sphere_shell.hpp>
+#include <stokescontact/scenes/random.hpp>
 
 #include <algorithm>
 #include <cmath>

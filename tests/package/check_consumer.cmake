@@ -30,9 +30,12 @@ file(READ ${prefix}/share/stokescontact/cmake/stokescontactTargets.cmake targets
 if(NOT NLOPT AND targets MATCHES "nlopt")
   message(FATAL_ERROR "the package configured without NLopt still names it:\n${targets}")
 endif()
+# No build type (no optimisation): the test is about the package, and the consumer's one
+# translation unit (the umbrella header and a contact step) compiles in 69 s against 94 s
+# at -O3 (GCC 12).
 run_step(${CMAKE_COMMAND} -S ${SOURCE_DIR}/tests/package/consumer -B ${WORK_DIR}/build
          -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-         -DCMAKE_BUILD_TYPE=Release -DEXPECT_NLOPT=${expect})
+         -DCMAKE_BUILD_TYPE= -DEXPECT_NLOPT=${expect})
 run_step(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run_step(${WORK_DIR}/build/consumer)
 # The runner is installed with the package (built with NLopt, as the project's own build is):
