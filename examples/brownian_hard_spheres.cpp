@@ -44,7 +44,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace brownian_hard_spheres {
 
 constexpr const char* kUsage =
     "usage: brownian_hard_spheres [--phi 0.05,0.15,0.25,0.35,0.45] [--n 500] [--dt 1e-4] [--d-hat 1e-3]\n"
@@ -187,9 +187,10 @@ int run(const Options& o) {
   return ok ? 0 : 1;
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   Options o;
   return ex::driver_main("brownian_hard_spheres", kUsage, [&] { o = parse(argc, argv); }, [&] { return run(o); });
 }
+
+}  // namespace brownian_hard_spheres

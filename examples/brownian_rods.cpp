@@ -68,7 +68,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace brownian_rods {
 
 constexpr const char* kUsage =
     "usage: brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]\n"
@@ -328,9 +328,10 @@ int run(const Options& o) {
   return ok ? 0 : 1;
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   Options o;
   return ex::driver_main("brownian_rods", kUsage, [&] { o = parse(argc, argv); }, [&] { return run(o); });
 }
+
+}  // namespace brownian_rods

@@ -38,7 +38,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace contact_step_scaling {
 
 constexpr const char* kUsage =
     "usage: contact_step_scaling [--sizes 1000,10000,100000] [--phi 0.3] [--cost blocks,matrix-free,formed]\n"
@@ -178,9 +178,10 @@ int run(const Options& o) {
   return ok ? 0 : 1;
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   Options o;
   return ex::driver_main("contact_step_scaling", kUsage, [&] { o = parse(argc, argv); }, [&] { return run(o); });
 }
+
+}  // namespace contact_step_scaling

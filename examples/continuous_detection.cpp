@@ -46,7 +46,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace continuous_detection {
 
 constexpr const char* kUsage =
     "usage: continuous_detection [--part tunnelling,galilean,overhead] [--sizes 1000,10000,100000]\n"
@@ -279,8 +279,7 @@ void overhead(ex::JsonLines& sink, const std::vector<std::size_t>& sizes, int re
   }
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   try {
     ex::Arguments args(argc, argv);
@@ -309,3 +308,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace continuous_detection

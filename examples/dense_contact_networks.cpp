@@ -33,7 +33,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace dense_contact_networks {
 
 constexpr const char* kUsage =
     "usage: dense_contact_networks [--part ball,jammed] [--spheres 1000] [--steps 300] [--phi 0.45,0.5,0.55,0.6]\n"
@@ -186,9 +186,10 @@ int run(const Options& o) {
   return ok ? 0 : 1;
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   Options o;
   return ex::driver_main("dense_contact_networks", kUsage, [&] { o = parse(argc, argv); }, [&] { return run(o); });
 }
+
+}  // namespace dense_contact_networks

@@ -45,7 +45,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace fig4_spheres {
 
 constexpr const char* kUsage =
     "usage: fig4_spheres [--configs 200] [--seed 1] [--phi 0.24,0.12] [--spheres 500] [--solver NAME]\n"
@@ -310,8 +310,7 @@ void run_table1(const Options& o, M& mobility) {
   print_table1(o, deviations, sink);
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   Options o;
   return ex::driver_main(
@@ -321,3 +320,5 @@ int main(int argc, char** argv) {
         std::visit([&](auto& m) { o.table1 ? run_table1(o, m) : run_fig4(o, m); }, mobility);
       });
 }
+
+}  // namespace fig4_spheres

@@ -59,7 +59,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace fig7_rod_chains {
 
 constexpr const char* kUsage =
     "usage: fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat LIST] [--solver NAME]\n"
@@ -342,8 +342,7 @@ void run_resolution(const Options& o) {
   }
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   Options o;
   return ex::driver_main(
@@ -362,3 +361,5 @@ int main(int argc, char** argv) {
         std::visit([&](auto& m) { run_all(o, m); }, mobility);
       });
 }
+
+}  // namespace fig7_rod_chains

@@ -51,7 +51,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace fig8_biaxial {
 
 constexpr const char* kUsage =
     "usage: fig8_biaxial [--d-hat 0.01,0.1] [--dt 0.02,0.01,0.005] [--t-end 9] [--t-s 4.36] [--rows 5]\n"
@@ -274,8 +274,7 @@ void run_all(const Options& o, M& mobility) {
                 s.applications, s.wall, s.error.empty() ? "" : (" ERROR: " + s.error).c_str());
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   Options o;
   return ex::driver_main(
@@ -287,3 +286,5 @@ int main(int argc, char** argv) {
         std::visit([&](auto& m) { run_all(o, m); }, mobility);
       });
 }
+
+}  // namespace fig8_biaxial

@@ -45,7 +45,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace fig9_boomerangs {
 
 constexpr const char* kUsage =
     "usage: fig9_boomerangs [--configs 200] [--seed 1] [--boomerangs 40] [--side 12] [--min-gap 1e-2]\n"
@@ -241,8 +241,7 @@ void run_resolution(const Options& o) {
   }
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   try {
     const Options o = parse(argc, argv);
@@ -258,3 +257,5 @@ int main(int argc, char** argv) {
     return 2;
   }
 }
+
+}  // namespace fig9_boomerangs

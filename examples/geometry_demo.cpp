@@ -18,7 +18,7 @@
 
 namespace sc = stokescontact;
 
-namespace {
+namespace geometry_demo {
 
 sc::Pose pose_at(double x, double y, double z, double angle = 0.0,
                  const sc::Vec3& axis = sc::Vec3::UnitX()) {
@@ -43,8 +43,7 @@ struct Reporter {
   }
 };
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   std::string output;
   for (int i = 1; i < argc; ++i) {
@@ -92,3 +91,5 @@ int main(int argc, char** argv) {
   if (!output.empty()) std::printf("\nwrote %s\n", output.c_str());
   return 0;
 }
+
+}  // namespace geometry_demo

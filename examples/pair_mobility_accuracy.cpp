@@ -24,7 +24,7 @@
 
 namespace sc = stokescontact;
 
-namespace {
+namespace pair_mobility_accuracy {
 
 constexpr double kPi = std::numbers::pi;
 constexpr std::array<double, 6> kGaps{0.1, 0.2, 0.5, 1.0, 2.0, 4.0};
@@ -65,8 +65,7 @@ sc::MatX model_matrix(const std::string& model, double gap) {
   return m.dense_matrix();
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   std::string output;
   int max_shell = 162;
@@ -117,3 +116,5 @@ int main(int argc, char** argv) {
   if (!output.empty()) std::printf("\nwrote %s\n", output.c_str());
   return 0;
 }
+
+}  // namespace pair_mobility_accuracy

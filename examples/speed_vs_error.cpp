@@ -35,7 +35,7 @@
 namespace sc = stokescontact;
 namespace ex = examples;
 
-namespace {
+namespace speed_vs_error {
 
 constexpr const char* kUsage =
     "usage: speed_vs_error [--configs 20] [--seed 1] [--scenes fig4-0.24,fig4-0.12,jammed-0.55]\n"
@@ -210,9 +210,10 @@ void run(const Options& o) {
   print_summary(o, summaries);
 }
 
-}  // namespace
-
+// The program's entry point (examples/CMakeLists.txt: the drivers are compiled in batches).
 int main(int argc, char** argv) {
   Options o;
   return ex::driver_main("speed_vs_error", kUsage, [&] { o = parse(argc, argv); }, [&] { run(o); });
 }
+
+}  // namespace speed_vs_error
