@@ -278,7 +278,6 @@ TEST(DefaultSolver, SqueezedLatticeIsSeparatedAtComplementarity) {
   EXPECT_LE(def.lambda_sum, lcp.lambda_sum * (1.0 + 1e-3));
 }
 
-
 // The probed model on the working set W embedded among all flagged pairs, as the LCP sequence
 // that finishes a round takes it: W's entries at W's positions (brute force, entry by entry),
 // every other pair alone on its row with the mean of W's diagonal.
