@@ -7,7 +7,8 @@
 //
 //   brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]
 //                 [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]
-//                 [--directions particle|surface|overlap-ends] [--start random|aligned] [--melt 0]
+//                 [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]
+//                 [--start random|aligned] [--melt 0]
 //                 [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]
 //                 [--output FILE]
 //
@@ -21,7 +22,8 @@
 // nematic order; --progress K writes every K-th melt step's diagnostics to stderr as JSON).
 // Every (U0, dt) runs from that start; given several --dt, a row "dt -> 0" per U0
 // extrapolates Z = Z_0 + c sqrt(dt) (brownian_pressure.hpp). --directions: the contact
-// directions (overlap-ends holds near-parallel rods at both ends of their overlap);
+// directions (overlap-ends holds near-parallel rods at both ends of their overlap, when it is
+// at least --overlap-ends-min-overlap times the radius: ContactStepOptions::overlap_ends_min_overlap);
 // --max-substep-halvings: TimeStepperOptions::max_substep_halvings (0: a step the solver
 // fails ends the run at once, with the solver's message). Per run, the collision pressure is
 // reported as Yan's
@@ -73,7 +75,8 @@ namespace brownian_rods {
 constexpr const char* kUsage =
     "usage: brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]\n"
     "                     [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]\n"
-    "                     [--directions particle|surface|overlap-ends] [--start random|aligned] [--melt 0]\n"
+    "                     [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]\n"
+    "                     [--start random|aligned] [--melt 0]\n"
     "                     [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]\n"
     "                     [--output FILE]\n";
 
@@ -90,6 +93,7 @@ struct Options {
   int halvings = 4;   // TimeStepperOptions::max_substep_halvings
   std::string solver = "default";
   ex::RodDirections directions = ex::RodDirections::particle;
+  double min_overlap = sc::ContactStepOptions{}.overlap_ends_min_overlap;
   std::uint64_t seed = 1;
   double tolerance = 0.0;
   std::string output;
@@ -116,6 +120,7 @@ Options parse(int argc, char** argv) {
   o.directions = ex::parse_directions(args.text("--directions", "particle"));
   if (o.directions == ex::RodDirections::line)
     throw std::invalid_argument("--directions line needs line-contact rods; use particle, surface or overlap-ends");
+  o.min_overlap = args.number("--overlap-ends-min-overlap", o.min_overlap, 1e-12);
   o.start = args.text("--start", "random");
   if (o.start != "random" && o.start != "aligned")
     throw std::invalid_argument("--start must be random or aligned, got '" + o.start + "'");
@@ -175,6 +180,7 @@ std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, cons
   options.d_hat = o.d_hat;
   options.box = sc::PeriodicBox{sc::Vec3::Constant(s.side)};
   options.contact_step.directions = ex::contact_directions(o.directions);
+  options.contact_step.overlap_ends_min_overlap = o.min_overlap;
   options.max_substep_halvings = o.halvings;
   options.brownian.emplace();
   options.brownian->kT = 1.0;
@@ -267,7 +273,8 @@ int run(const Options& o) {
                 sc::json_number(start_order) + ", \"u0_over_L_DR\": " + sc::json_number(u0_scaled) +
                 ", \"u0\": " + sc::json_number(u0) + ", \"D_R\": " + sc::json_number(s.D_R) + ", \"dt_D_R\": " +
                 sc::json_number(dt_D_R) + ", \"d_hat\": " + sc::json_number(o.d_hat) + ", \"solver\": \"" +
-                o.solver + "\", \"directions\": \"" + ex::directions_name(o.directions) + "\", \"seed\": " +
+                o.solver + "\", \"directions\": \"" + ex::directions_name(o.directions) +
+                "\", \"overlap_ends_min_overlap\": " + sc::json_number(o.min_overlap) + ", \"seed\": " +
                 std::to_string(o.seed) + ", \"steps_averaged\": " +
                 std::to_string(r.steps) + ", \"B2n\": " + sc::json_number(b2n) + ", \"Z\": " + sc::json_number(z) +
                 ", \"Z_error\": " + sc::json_number(z_error) + ", \"pressure_ratio\": " + sc::json_number(ratio) +

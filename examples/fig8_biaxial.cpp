@@ -8,7 +8,8 @@
 //                [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
 //                [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]
 //                [--line-angle 0.05] [--cost formed|matrix-free|blocks|automatic] [--max-steps N] [--tilt 0]
-//                [--max-iterations N] [--max-correction-turn 0.5] [--output FILE]
+//                [--max-iterations N] [--max-correction-turn 0.5] [--overlap-ends-min-overlap 0.1]
+//                [--output FILE]
 //
 // --d-hat is in units of R_rod. --directions: the paper's d^P ("particle", eq. 20-21) and d^S
 // ("surface", eq. 22-23, node spacing R_rod / 2 unless --node-spacing), or "line": d^P
@@ -27,6 +28,8 @@
 // the symmetric start, to see whether the contacts restore or amplify it.
 // --max-correction-turn: ContactStepOptions::max_correction_turn in radians (a step whose
 // correction turns a rod further is refused and sub-stepped; a large value lifts the guard).
+// --overlap-ends-min-overlap: ContactStepOptions::overlap_ends_min_overlap, in units of R_rod
+// (near-parallel pairs overlapping less are held at their closest points).
 #include <stokescontact/contact/contact_pairs.hpp>
 #include <stokescontact/core/rigid_motion.hpp>
 #include <stokescontact/dynamics/nematic_order.hpp>
@@ -59,7 +62,8 @@ constexpr const char* kUsage =
     "                    [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
     "                    [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]\n"
     "                    [--line-angle 0.05] [--cost formed|matrix-free|blocks|automatic] [--max-steps N] [--tilt 0]\n"
-    "                    [--max-iterations N] [--max-correction-turn 0.5] [--output FILE]\n";
+    "                    [--max-iterations N] [--max-correction-turn 0.5] [--overlap-ends-min-overlap 0.1]\n"
+    "                    [--output FILE]\n";
 
 constexpr double kLRod = 2.0, kRRod = kLRod / 4.0;  // Sec. 3.2.3
 
@@ -102,6 +106,8 @@ Options parse(int argc, char** argv) {
   o.max_steps = static_cast<long>(args.integer("--max-steps", 0, 0));
   o.tilt = args.number("--tilt", 0.0);
   o.step.max_correction_turn = args.number("--max-correction-turn", o.step.max_correction_turn, 1e-12);
+  o.step.overlap_ends_min_overlap =
+      args.number("--overlap-ends-min-overlap", o.step.overlap_ends_min_overlap, 1e-12);
   // The solver's iteration limit per round (LCPs of the LCP sequence, corrections of the
   // default solver); without it each keeps its own (20, 50).
   if (const auto limit = args.positive("--max-iterations")) {
@@ -234,7 +240,8 @@ std::string summary_json(const Options& o, const RunSummary& s) {
   return "{\"record\": \"summary\", \"rods\": " + std::to_string(o.rows * o.columns) + ", \"mobility\": \"" +
          ex::rod_mobility_name(o.mobility) + "\", \"solver\": \"" + sc::contact_solver_name(o.solver) +
          "\", \"directions\": \"" + ex::directions_name(o.directions) +
-         "\", \"max_correction_turn_bound\": " + sc::json_number(o.step.max_correction_turn) + ", \"d_hat_over_R\": " +
+         "\", \"max_correction_turn_bound\": " + sc::json_number(o.step.max_correction_turn) +
+         ", \"overlap_ends_min_overlap\": " + sc::json_number(o.step.overlap_ends_min_overlap) + ", \"d_hat_over_R\": " +
          sc::json_number(s.d_hat_fraction) + ", \"dt\": " + sc::json_number(s.dt) +
          ", \"steps\": " + std::to_string(s.steps) + ", \"triggered\": " + std::to_string(s.triggered) +
          ", \"paper_triggered\": " + std::to_string(paper_count(s.dt, s.d_hat_fraction, false)) +

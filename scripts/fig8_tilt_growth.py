@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """How fast the rods of fig8_biaxial's grid leave alignment: the growth of the largest turn.
 
-usage: scripts/fig8_tilt_growth.py RUN.jsonl [RUN.jsonl ...]
+usage: scripts/fig8_tilt_growth.py RUN.jsonl[.gz] [RUN.jsonl[.gz] ...]
 
 For each run (d_hat, dt) the steps whose largest rod turn lies in the exponential window
 [1e-13, 1e-4] rad give the growth factor g per step (the median of turn(n+1) / turn(n)).
@@ -9,6 +9,7 @@ A forward Euler step of a linear instability x' = sigma x has g = 1 + sigma dt, 
 sigma = (g - 1) / dt is the same at every dt when the growth is the dynamics' own and not the
 discretisation's. Prints one markdown row per run.
 """
+import gzip
 import json
 import math
 import statistics
@@ -17,7 +18,7 @@ import sys
 
 def runs(path):
     steps = {}
-    for line in open(path):
+    for line in (gzip.open(path, "rt") if path.endswith(".gz") else open(path)):
         if not line.strip():
             continue
         r = json.loads(line)

@@ -2,12 +2,13 @@
 """Broms & Tornberg Fig. 8d-e from fig8_biaxial's JSON lines: the order parameter S(t) (eq. 33)
 and the largest |x| of any rod, for each contact-direction choice.
 
-usage: scripts/plot_fig8.py OUT.png RUN.jsonl [RUN.jsonl ...]
+usage: scripts/plot_fig8.py OUT.png RUN.jsonl[.gz] [RUN.jsonl[.gz] ...]
 
 One panel per (d_hat, dt): S(t) of every run file (one line per file: its solver and contact
 directions, d^P = particle, d^S = surface, line = line contacts). A run that stopped early (a
 failed separation) ends in a cross. The bottom row: max |x_i| against t, same lines.
 """
+import gzip
 import json
 import sys
 
@@ -23,7 +24,7 @@ DASH = {"default": "-", "lcp-newton": "--"}
 
 def load(path):
     steps, summaries = [], []
-    for line in open(path):
+    for line in (gzip.open(path, "rt") if path.endswith(".gz") else open(path)):
         if not line.strip():
             continue
         r = json.loads(line)

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -14,6 +15,7 @@
 
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/solvers/contact_solver.hpp"
+#include "stokescontact/dynamics/background_flow.hpp"
 #include "stokescontact/geometry/overlap_ends.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 
@@ -230,7 +232,8 @@ TEST(OverlapEnds, CrossingPairKeepsItsClosestPoints) {
                                                               std::span<const sc::Pose>(poses), 0.1);
   ASSERT_EQ(pairs.size(), 1u);
   const std::vector<sc::ContactPair> split =
-      sc::split_overlap_ends(pairs, std::span<const sc::Spherocylinder>(shapes), std::span<const sc::Pose>(poses), 0.1);
+      sc::split_overlap_ends(pairs, std::span<const sc::Spherocylinder>(shapes), std::span<const sc::Pose>(poses), 0.1,
+                             0.1);
   ASSERT_EQ(split.size(), 3u);
   EXPECT_FALSE(split[0].segment_end);
   EXPECT_NEAR(split[0].points.distance, kDHat, 1e-12);
@@ -238,6 +241,95 @@ TEST(OverlapEnds, CrossingPairKeepsItsClosestPoints) {
   const double end_gap = std::hypot(1.0 + kDHat, 4.0 * std::sin(0.05) / 2.0) - 1.0;
   EXPECT_NEAR(split[1].points.distance, end_gap, 1e-3 * kDHat);
   EXPECT_NEAR(split[2].points.distance, end_gap, 1e-3 * kDHat);
+}
+
+// Rods side by side and staggered along their axes, overlapping by 0.8 R (a row of the Fig. 8
+// grid tilted like falling dominoes overlaps by 0.97 R), the second turned by 0.002 rad about
+// z and spun through parallel by the trial step. They cannot turn through each other: held at
+// both ends of the overlap (the default, overlap_ends_min_overlap = 0.1) the step stops the
+// pair at parallel. Held at its closest points (a minimum overlap of 1 R, which this pair
+// misses), the force acts at the end that is closer at Q*, and its torque turns the rod back
+// past parallel: measured, 2.2e-3 rad the other way.
+TEST(OverlapEnds, StaggeredPairTurningThroughParallelStopsAtParallel) {
+  const double theta = 0.002, stagger = kRod.length - 0.8 * kRod.radius;
+  Pair s(kDHat, theta);
+  s.poses[1].x.x() = stagger;
+  s.poses[1].x.y() += 1.0001 * kDHat - sc::closest_points(kRod, s.poses[0], kRod, s.poses[1]).distance;
+  s.mobility.set_configuration(s.poses);
+  s.U(11) -= 2.0 * theta / kDt;  // rod 1 turns from theta to -theta in the trial step
+  for (const double min_overlap : {0.1, 1.0}) {
+    sc::ContactStepOptions o = overlap_ends();
+    o.overlap_ends_min_overlap = min_overlap;
+    const sc::ContactStepResult r = sc::solve_contact_step(s.problem(), s.mobility, o, sc::ContactSolver{});
+    std::printf("[staggered pair] min overlap %.1f R: %zu contacts, %s, turn after %.3g rad\n", min_overlap,
+                r.pairs.size(), std::string(sc::to_string(r.status)).c_str(), relative_turn(r.poses));
+    ASSERT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+    EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+    if (min_overlap < 0.8) {
+      EXPECT_EQ(r.pairs.size(), 2u);
+      EXPECT_LT(std::abs(relative_turn(r.poses)), 1e-6);
+    } else {
+      EXPECT_EQ(r.pairs.size(), 1u);
+      EXPECT_GT(relative_turn(r.poses), 0.5 * theta);
+    }
+  }
+}
+
+// The 30-rod grid of Fig. 8 (fig8_biaxial --solver default --directions overlap-ends
+// --d-hat 0.1 --dt 0.01) after 148 steps and 6 sub-steps of dt / 16: the rows tilted by 1-31
+// degrees like falling dominoes, every rod held at d_hat, neighbours in a row staggered along
+// their axes by about half a rod. One step of dt = 0.01 in the biaxial compression flow.
+// With a minimum overlap of 1 R the side pairs of a row (overlap 0.97 R) were held at their
+// closest points, and the default solver and its fallbacks ended on far roots (lambda_max
+// 1.7e5, turns of radians, min d / d_hat -2.0; the run stopped in this step, from t = 1.48).
+// Held at both ends: converged with lambda_max 63.
+TEST(OverlapEnds, DominoTiltedRodGridStepConverges) {
+  const sc::Spherocylinder rod{1.0, 0.5};
+  const std::vector<std::array<double, 7>> rows{
+      {0, -2.6211446544037096, -3.4236260562389242, 0.99995314761209619, -0.0096800093316701374, 0, 0},
+      {0, -1.5161696037988615, -3.4975962121606599, 0.99774574905384517, -0.067107527483745752, 0, 0},
+      {0, -0.40557719640455292, -3.5655141753705664, 0.99194884587317833, -0.12663920076686191, 0, 0},
+      {0, 0.73045493279813944, -3.6082664130563886, 0.98248123698925804, -0.1863615275856515, 0, 0},
+      {0, 1.8208261428581805, -3.709126242910473, 0.98218896375951914, -0.1878958207864192, 0, 0},
+      {0, 2.9278399967828492, -3.7675389402387571, 0.9821131630307387, -0.18829162222934312, 0, 0},
+      {0, -2.8890629514565203, -1.5805289631312318, 0.96653111144157811, -0.25654943113464107, 0, 0},
+      {0, -1.7217471990204485, -1.6581144878937111, 0.96598309705262242, -0.2586052130345094, 0, 0},
+      {0, -0.55632329014544435, -1.7390650337016729, 0.96616628984815922, -0.25791994952124769, 0, 0},
+      {0, 0.61030154166059636, -1.8164980210521606, 0.96619019137243356, -0.25783039792797924, 0, 0},
+      {0, 1.7978312831559922, -1.8722820053496931, 0.96424722567192545, -0.26500431653841983, 0, 0},
+      {0, 3.0180312917291512, -1.8897201068171239, 0.96217144039350744, -0.27244470868615384, 0, 0},
+      {0, -2.9393449796093205, 0.17278324250543994, 0.9635497926262151, -0.26752905847772473, 0, 0},
+      {0, -1.7487090730437793, 0.11710264097852321, 0.96612530955627651, -0.25807341249107602, 0, 0},
+      {0, -0.58184798930113857, 0.039857531322073619, 0.96668472884980583, -0.25596998849196673, 0, 0},
+      {0, 0.58188933029450929, -0.039796421593651495, 0.96651708380536505, -0.25660227339673541, 0, 0},
+      {0, 1.7487603153728044, -0.11716562736393696, 0.9661109279089336, -0.25812724570439921, 0, 0},
+      {0, 2.9393618851382719, -0.17275527889482664, 0.96357125122226495, -0.26745175979596569, 0, 0},
+      {0, -3.0180179939440293, 1.8897214903886501, 0.96218731284595016, -0.27238864697026138, 0, 0},
+      {0, -1.7978783363102468, 1.8723507850931933, 0.96428146652701718, -0.26487969592346078, 0, 0},
+      {0, -0.61041055750366913, 1.8166313941495866, 0.96606283269505644, -0.25830718783108486, 0, 0},
+      {0, 0.55647908129315049, 1.7388674701097999, 0.96625060909007443, -0.25760388279888202, 0, 0},
+      {0, 1.7218898464352559, 1.6581887993564901, 0.96601929235216899, -0.25846997273071187, 0, 0},
+      {0, 2.8890191634079905, 1.5805570684436505, 0.96651968345624639, -0.25659248136225155, 0, 0},
+      {0, -2.9280401479040434, 3.7674685883381041, 0.98210167544725691, -0.18835153061149018, 0, 0},
+      {0, -1.8209917617920968, 3.7091141930012923, 0.98215637699295388, -0.18806608182252016, 0, 0},
+      {0, -0.73038887183520906, 3.6081722185697971, 0.98251582116575698, -0.18617911042589685, 0, 0},
+      {0, 0.40555402807602853, 3.5656176474354275, 0.99196096112006416, -0.1265442674077287, 0, 0},
+      {0, 1.5160083174853836, 3.4976103877304912, 0.9977433317775567, -0.067143457562300224, 0, 0},
+      {0, 2.6211404662837827, 3.4237023827942528, 0.99995427179319751, -0.0095631753375257488, 0, 0}};
+  std::vector<sc::Pose> poses;
+  for (const auto& r : rows) poses.push_back({sc::Vec3(r[0], r[1], r[2]), sc::Quat(r[3], r[4], r[5], r[6])});
+  const std::vector<sc::Spherocylinder> shapes{rod};
+  sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
+  const sc::VecX U = sc::LinearBackgroundFlow::biaxial_compression(1.0).body_velocities(poses, 6);
+  const sc::ContactStepProblem<sc::Spherocylinder> problem{shapes, poses, U, 0.01, 0.1 * rod.radius, 0.0, 1.0, {}};
+  const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, overlap_ends(), sc::ContactSolver{});
+  std::printf("[domino grid] %s, %zu contacts, lambda_max %.3g, largest correction turn %.3g rad, min d / d_hat %.6f\n",
+              std::string(sc::to_string(r.status)).c_str(), r.pairs.size(), r.lambda_max, r.max_correction_turn,
+              r.min_distance_ratio);
+  ASSERT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+  EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+  EXPECT_LT(r.lambda_max, 1e3);
+  EXPECT_LT(r.max_correction_turn, 0.05);
 }
 
 TEST(OverlapEnds, BadOptionsNameTheField) {
@@ -249,6 +341,15 @@ TEST(OverlapEnds, BadOptionsNameTheField) {
     FAIL() << "no error";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("ContactStepOptions.overlap_ends_angle"), std::string::npos) << e.what();
+  }
+  o = overlap_ends();
+  o.overlap_ends_min_overlap = 0.0;
+  try {
+    (void)sc::solve_contact_step(s.problem(), s.mobility, o, sc::ContactSolver{});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("ContactStepOptions.overlap_ends_min_overlap"), std::string::npos)
+        << e.what();
   }
   const std::vector<sc::Sphere> spheres{sc::Sphere{1.0}};
   const std::vector<sc::Pose> poses{{sc::Vec3::Zero(), sc::Quat::Identity()}, {sc::Vec3(3, 0, 0), sc::Quat::Identity()}};

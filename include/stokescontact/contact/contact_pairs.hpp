@@ -113,13 +113,14 @@ inline ContactPair overlap_end_pair(const Spherocylinder& a, const Pose& pose_a,
 
 // Near-parallel rods as line contacts held at both ends of their overlap (geometry/
 // overlap_ends.hpp; ContactDirections::overlap_ends): each pair of Spherocylinders whose
-// centre lines meet at an angle below max_angle, overlapping by at least the smaller radius,
-// becomes one contact per overlap end, plus its closest points when those lie inside the
+// centre lines meet at an angle below max_angle, overlapping by at least min_overlap times
+// the smaller radius, becomes one contact per overlap end, plus its closest points when those lie inside the
 // overlap below both ends by more than rounding (the rods cross there). Other pairs, and
 // pairs of other shapes, stay as they are. Order is kept: a pair's contacts replace it.
 template <Shape S>
 std::vector<ContactPair> split_overlap_ends(std::vector<ContactPair> pairs, std::span<const S> shapes,
-                                            std::span<const Pose> poses, double max_angle) {
+                                            std::span<const Pose> poses, double max_angle,
+                                            double min_overlap) {
   if constexpr (!std::is_same_v<S, Spherocylinder>) {
     return pairs;
   } else {
@@ -136,7 +137,7 @@ std::vector<ContactPair> split_overlap_ends(std::vector<ContactPair> pairs, std:
       const Pose pose_b = shifted(poses[static_cast<std::size_t>(p.j)], p.image_shift);
       const auto ends = overlap_ends(to_world(centre_curve(a).segments[0], pose_a),
                                      to_world(centre_curve(b).segments[0], pose_b), max_angle,
-                                     std::min(a.radius, b.radius));
+                                     min_overlap * std::min(a.radius, b.radius));
       if (!ends) {
         out.push_back(std::move(p));
         continue;

@@ -149,8 +149,13 @@ struct ContactStepOptions {
   double node_spacing = 0.0;
   SurfaceWeights surface_weights;
   // overlap_ends: pairs of rods whose centre lines meet below this angle (radians) are held
-  // at both ends of their overlap.
+  // at both ends of their overlap when it is at least overlap_ends_min_overlap times the
+  // smaller radius long; a shorter overlap keeps the closest points, whose jump across it
+  // moves the force by at most that length. A pair held at one end of its overlap misses the
+  // other end's gap by the step's turn times the overlap (the staggered rows of the Fig. 8
+  // grid, overlap 0.97 R, stopped every solver with a minimum of 1 R: docs/results.md).
   double overlap_ends_angle = 0.1;
+  double overlap_ends_min_overlap = 0.1;
   // The largest turn dt |omega_c| the contact correction M D lambda may give a body in one
   // step, in radians. Eq. 13 is linear in the rotation, so a correction turning a body by
   // radians to hold a gap of d_hat is a root of the linearised problem, not a motion: a step
@@ -169,6 +174,9 @@ struct ContactStepOptions {
     if (!(overlap_ends_angle > 0.0 && overlap_ends_angle <= 0.5 * std::numbers::pi))
       fail_argument("ContactStepOptions.overlap_ends_angle",
                     "must lie in (0, pi/2], got " + std::to_string(overlap_ends_angle));
+    if (!(overlap_ends_min_overlap > 0.0 && std::isfinite(overlap_ends_min_overlap)))
+      fail_argument("ContactStepOptions.overlap_ends_min_overlap",
+                    "must be positive and finite, got " + std::to_string(overlap_ends_min_overlap));
     if (!(max_correction_turn > 0.0))
       fail_argument("ContactStepOptions.max_correction_turn",
                     "must be > 0 radians, got " + std::to_string(max_correction_turn));
@@ -651,7 +659,8 @@ class ContactStep {
         continue;
       }
       for (ContactPair& p : split_overlap_ends(std::vector<ContactPair>{split[k]}, problem_.shapes,
-                                               std::span<const Pose>(trial_), options_.overlap_ends_angle)) {
+                                               std::span<const Pose>(trial_), options_.overlap_ends_angle,
+                                               options_.overlap_ends_min_overlap)) {
         pairs_.push_back(std::move(p));
         carried_.emplace_back();
       }
