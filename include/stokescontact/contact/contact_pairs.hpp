@@ -114,9 +114,10 @@ inline ContactPair overlap_end_pair(const Spherocylinder& a, const Pose& pose_a,
 // Near-parallel rods as line contacts held at both ends of their overlap (geometry/
 // overlap_ends.hpp; ContactDirections::overlap_ends): each pair of Spherocylinders whose
 // centre lines meet at an angle below max_angle, overlapping by at least min_overlap times
-// the smaller radius, becomes one contact per overlap end, plus its closest points when those lie inside the
-// overlap below both ends by more than rounding (the rods cross there). Other pairs, and
-// pairs of other shapes, stay as they are. Order is kept: a pair's contacts replace it.
+// the smaller radius, becomes one contact per overlap end, plus its closest points when those
+// lie inside the overlap below both ends by more than rounding (the rods cross there). Other
+// pairs, and pairs of other shapes, stay as they are. Order is kept: a pair's contacts
+// replace it.
 template <Shape S>
 std::vector<ContactPair> split_overlap_ends(std::vector<ContactPair> pairs, std::span<const S> shapes,
                                             std::span<const Pose> poses, double max_angle,
