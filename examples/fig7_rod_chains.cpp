@@ -9,6 +9,7 @@
 //
 //   fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat 1e-4,3e-4,...,1e-1]
 //                   [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
+//                   [--multiblob-solver matrix-free|dense|adaptive|automatic]
 //                   [--directions particle|surface|line|overlap-ends] [--cost automatic|blocks|formed|matrix-free]
 //                   [--output FILE] [--scene FILE]
 //   fig7_rod_chains --resolution [--rings 4,6,8,12,16] [--reference-ring 24] [--output FILE]
@@ -64,6 +65,7 @@ namespace fig7_rod_chains {
 constexpr const char* kUsage =
     "usage: fig7_rod_chains [--chains 100] [--rods 40] [--seed 1] [--d-hat LIST] [--solver NAME]\n"
     "                       [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
+    "                       [--multiblob-solver matrix-free|dense|adaptive|automatic]\n"
     "                       [--directions particle|surface|line|overlap-ends] [--cost automatic|blocks|formed|matrix-free]\n"
     "                       [--output FILE] [--scene FILE]\n"
     "       fig7_rod_chains --resolution [--rings 4,6,8,12,16] [--reference-ring 24] [--output FILE]\n";
@@ -78,6 +80,7 @@ struct Options {
   sc::ContactSolver solver;
   ex::RodMobilityModel mobility = ex::RodMobilityModel::free_draining;
   int blobs_per_ring = 8;
+  sc::MultiblobSolver multiblob_solver = sc::MultiblobSolver::matrix_free;
   ex::RodDirections directions = ex::RodDirections::particle;
   sc::MobilityCost cost = sc::MobilityCost::automatic;
   std::string output;
@@ -97,6 +100,8 @@ Options parse(int argc, char** argv) {
   o.solver = sc::contact_solver_from_name(args.text("--solver", "default"));
   o.mobility = ex::parse_rod_mobility(args.text("--mobility", "free-draining"));
   o.blobs_per_ring = static_cast<int>(args.integer("--blobs-per-ring", 8, 3));
+  o.multiblob_solver =
+      sc::multiblob_solver_from_name(args.text("--multiblob-solver", "matrix-free"), "--multiblob-solver");
   o.directions = ex::parse_directions(args.text("--directions", "particle"));
   o.cost = sc::mobility_cost_from_name(args.text("--cost", "automatic"), "--cost");
   o.output = args.text("--output", "");
@@ -357,7 +362,8 @@ int main(int argc, char** argv) {
           return;
         }
         ex::RodMobility mobility = ex::make_rod_mobility(o.mobility, ex::paper_rod(kLRod, kRRod),
-                                                          static_cast<std::size_t>(o.rods), o.blobs_per_ring);
+                                                          static_cast<std::size_t>(o.rods), o.blobs_per_ring,
+                                                          o.multiblob_solver);
         std::visit([&](auto& m) { run_all(o, m); }, mobility);
       });
 }

@@ -6,6 +6,7 @@
 //   fig8_biaxial [--d-hat 0.01,0.1] [--dt 0.02,0.01,0.005] [--t-end 9] [--t-s 4.36]
 //                [--rows 5] [--columns 6] [--spacing-y 1.5] [--spacing-z 3]
 //                [--solver NAME] [--mobility free-draining|multiblob] [--blobs-per-ring 8]
+//                [--multiblob-solver matrix-free|dense|adaptive|automatic]
 //                [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]
 //                [--line-angle 0.05] [--cost formed|matrix-free|blocks|automatic] [--max-steps N] [--tilt 0]
 //                [--max-iterations N] [--max-correction-turn 0.5] [--overlap-ends-min-overlap 0.1]
@@ -60,6 +61,7 @@ constexpr const char* kUsage =
     "usage: fig8_biaxial [--d-hat 0.01,0.1] [--dt 0.02,0.01,0.005] [--t-end 9] [--t-s 4.36] [--rows 5]\n"
     "                    [--columns 6] [--spacing-y 1.5] [--spacing-z 3] [--solver NAME]\n"
     "                    [--mobility free-draining|multiblob] [--blobs-per-ring 8]\n"
+    "                    [--multiblob-solver matrix-free|dense|adaptive|automatic]\n"
     "                    [--directions particle|surface|line|overlap-ends] [--node-spacing 0] [--line-width 1]\n"
     "                    [--line-angle 0.05] [--cost formed|matrix-free|blocks|automatic] [--max-steps N] [--tilt 0]\n"
     "                    [--max-iterations N] [--max-correction-turn 0.5] [--overlap-ends-min-overlap 0.1]\n"
@@ -75,6 +77,7 @@ struct Options {
   sc::ContactSolver solver;
   ex::RodMobilityModel mobility = ex::RodMobilityModel::free_draining;
   int blobs_per_ring = 8;
+  sc::MultiblobSolver multiblob_solver = sc::MultiblobSolver::matrix_free;
   ex::RodDirections directions = ex::RodDirections::particle;
   double line_width = 2.0 * kRRod, line_angle = 0.05;
   sc::ContactStepOptions step;
@@ -97,6 +100,8 @@ Options parse(int argc, char** argv) {
   o.solver = sc::contact_solver_from_name(args.text("--solver", "default"));
   o.mobility = ex::parse_rod_mobility(args.text("--mobility", "free-draining"));
   o.blobs_per_ring = static_cast<int>(args.integer("--blobs-per-ring", 8, 3));
+  o.multiblob_solver =
+      sc::multiblob_solver_from_name(args.text("--multiblob-solver", "matrix-free"), "--multiblob-solver");
   o.directions = ex::parse_directions(args.text("--directions", "particle"));
   o.step.directions = ex::contact_directions(o.directions);
   o.line_width = args.number("--line-width", 2.0 * kRRod, 1e-12);
@@ -168,6 +173,7 @@ struct RunSummary {
   std::size_t applications = 0;
   double wall = 0.0;
   std::string error;  // a step that threw
+  std::string multiblob_path;  // multiblob rods: "dense", "matrix-free" or "adaptive"
 };
 
 template <sc::Shape S, sc::MobilityOperator M>
@@ -181,6 +187,7 @@ RunSummary run(const Options& o, const S& rod, double fraction, double dt, M& mo
   options.contact_step = o.step;
   sc::TimeStepper<S, M> stepper({rod}, start, mobility, o.solver, options);
   RunSummary s;
+  s.multiblob_path = ex::multiblob_path(mobility);
   s.d_hat_fraction = fraction;
   s.dt = dt;
   long n_steps = std::lround(o.t_end / dt);
@@ -238,7 +245,8 @@ RunSummary run(const Options& o, const S& rod, double fraction, double dt, M& mo
 
 std::string summary_json(const Options& o, const RunSummary& s) {
   return "{\"record\": \"summary\", \"rods\": " + std::to_string(o.rows * o.columns) + ", \"mobility\": \"" +
-         ex::rod_mobility_name(o.mobility) + "\", \"solver\": \"" + sc::contact_solver_name(o.solver) +
+         ex::rod_mobility_name(o.mobility) + "\", \"multiblob_path\": \"" + s.multiblob_path +
+         "\", \"solver\": \"" + sc::contact_solver_name(o.solver) +
          "\", \"directions\": \"" + ex::directions_name(o.directions) +
          "\", \"max_correction_turn_bound\": " + sc::json_number(o.step.max_correction_turn) +
          ", \"overlap_ends_min_overlap\": " + sc::json_number(o.step.overlap_ends_min_overlap) + ", \"d_hat_over_R\": " +
@@ -289,7 +297,8 @@ int main(int argc, char** argv) {
       [&] {
         const sc::Spherocylinder rod = ex::paper_rod(kLRod, kRRod);
         ex::RodMobility mobility =
-            ex::make_rod_mobility(o.mobility, rod, static_cast<std::size_t>(o.rows * o.columns), o.blobs_per_ring);
+            ex::make_rod_mobility(o.mobility, rod, static_cast<std::size_t>(o.rows * o.columns), o.blobs_per_ring,
+                                  o.multiblob_solver);
         std::visit([&](auto& m) { run_all(o, m); }, mobility);
       });
 }

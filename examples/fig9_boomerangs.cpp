@@ -8,6 +8,7 @@
 //
 //   fig9_boomerangs [--configs 200] [--seed 1] [--boomerangs 40] [--side 12] [--min-gap 1e-2]
 //                   [--solver NAME] [--mobility free-draining|multiblob] [--blob-model curve|surface]
+//                   [--multiblob-solver matrix-free|dense|adaptive|automatic]
 //                   [--blob-spacing H] [--cost formed|matrix-free|blocks|automatic] [--directions surface|particle] [--output FILE]
 //   fig9_boomerangs --resolution [--spacings 0.5,0.35,0.25,0.18,0.125] [--reference-spacing 0.09]
 //
@@ -18,7 +19,8 @@
 // Mobility: free-draining = each body alone, its 6x6 mobility from the boomerang's curve blobs
 // (--blob-model curve: boomerang_curve_blobs, --blob-spacing default the tube radius; surface:
 // boomerang_surface_blobs at --blob-spacing, default 0.25); multiblob = the same blobs coupled
-// by RPY (the paper's rigid multiblob method), matrix-free GMRES.
+// by RPY (the paper's rigid multiblob method), matrix-free GMRES unless --multiblob-solver
+// says dense (one factorisation per configuration), adaptive or automatic (MultiblobOptions).
 // --resolution: the single-body mobility of the boomerang's blob grids (the curve chain, the
 // surface grids at --spacings) against a finer surface grid (--reference-spacing) taken as
 // the converged value: relative errors of the translation, rotation and coupling blocks
@@ -50,6 +52,7 @@ namespace fig9_boomerangs {
 constexpr const char* kUsage =
     "usage: fig9_boomerangs [--configs 200] [--seed 1] [--boomerangs 40] [--side 12] [--min-gap 1e-2]\n"
     "                       [--solver NAME] [--mobility free-draining|multiblob] [--blob-model curve|surface]\n"
+    "                       [--multiblob-solver matrix-free|dense|adaptive|automatic]\n"
     "                       [--blob-spacing H] [--cost formed|matrix-free|blocks|automatic] [--directions surface|particle] [--output FILE]\n"
     "       fig9_boomerangs --resolution [--spacings 0.5,0.35,0.25,0.18,0.125] [--reference-spacing 0.09]\n";
 
@@ -65,6 +68,7 @@ struct Options {
   sc::ContactSolver solver;
   std::string mobility = "free-draining";
   std::string blob_model = "curve";
+  sc::MultiblobSolver multiblob_solver = sc::MultiblobSolver::matrix_free;
   double blob_spacing = 0.0;
   sc::ContactStepOptions step;
   std::string output;
@@ -88,6 +92,8 @@ Options parse(int argc, char** argv) {
   o.blob_model = args.text("--blob-model", "curve");
   if (o.blob_model != "curve" && o.blob_model != "surface")
     throw std::invalid_argument("--blob-model must be curve or surface, got '" + o.blob_model + "'");
+  o.multiblob_solver =
+      sc::multiblob_solver_from_name(args.text("--multiblob-solver", "matrix-free"), "--multiblob-solver");
   o.blob_spacing = args.number("--blob-spacing", o.blob_model == "surface" ? 0.25 : 0.0, 0.0);
   o.step.cost = sc::mobility_cost_from_name(args.text("--cost", "matrix-free"), "--cost");
   const std::string directions = args.text("--directions", "surface");
@@ -147,7 +153,7 @@ BoomerangMobility make_mobility(const Options& o, const sc::Boomerang& b) {
   const sc::BlobModel blobs = blob_model(o, b);
   if (o.mobility == "multiblob") {
     sc::MultiblobOptions options;
-    options.solver = sc::MultiblobSolver::matrix_free;
+    options.solver = o.multiblob_solver;
     return BoomerangMobility(std::in_place_type<sc::MultiblobMobility>, blobs, o.boomerangs, options);
   }
   return BoomerangMobility(std::in_place_type<sc::FreeDrainingMobility>, sc::single_body_mobility(blobs, 1.0),

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <variant>
 
 namespace examples {
@@ -35,14 +36,22 @@ inline const char* rod_mobility_name(RodMobilityModel m) {
 
 using RodMobility = std::variant<sc::MultiblobMobility, sc::FreeDrainingMobility>;
 
+// The multiblob path a model takes ("dense", "matrix-free" or "adaptive"); "" for any other model.
+template <typename M>
+const char* multiblob_path(const M& mobility) {
+  if constexpr (std::is_same_v<M, sc::MultiblobMobility>) return sc::multiblob_solver_name(mobility.solver());
+  return "";
+}
+
 // 6 dofs per rod, viscosity 1. multiblob: the rod blob grid of mobility/rod_blobs.hpp with
-// `blobs_per_ring` blobs per ring, matrix-free GMRES; free-draining: slender-body drag (Yan et
-// al. eq. 45-50), no hydrodynamic interaction.
+// `blobs_per_ring` blobs per ring, solved by `solver` (matrix-free GMRES, one dense
+// factorisation per configuration, adaptive or automatic: MultiblobOptions);
+// free-draining: slender-body drag (Yan et al. eq. 45-50), no hydrodynamic interaction.
 inline RodMobility make_rod_mobility(RodMobilityModel model, const sc::Spherocylinder& rod, std::size_t n,
-                                     int blobs_per_ring) {
+                                     int blobs_per_ring, sc::MultiblobSolver solver) {
   if (model == RodMobilityModel::multiblob) {
     sc::MultiblobOptions options;
-    options.solver = sc::MultiblobSolver::matrix_free;
+    options.solver = solver;
     sc::RodBlobResolution resolution;
     resolution.blobs_per_ring = blobs_per_ring;
     return RodMobility(std::in_place_type<sc::MultiblobMobility>, sc::rod_blob_model(rod, resolution), n, options);

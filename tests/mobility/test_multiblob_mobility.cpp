@@ -228,6 +228,81 @@ TEST(MultiblobMobility, ZeroForceGivesZeroVelocity) {
   }
 }
 
+// The dense path factorises on the first apply after set_configuration: a configuration set
+// and replaced without an apply must not leave its factorisation behind, and one set again
+// must be factorised again.
+TEST(MultiblobMobility, DenseFactorisationFollowsTheLatestConfiguration) {
+  const sc::BlobModel shell = sc::sphere_shell(12, 1.0);
+  const auto a = lattice_poses(4, 3.0, 65), b = lattice_poses(4, 3.0, 66), c = lattice_poses(4, 2.6, 67);
+  const sc::VecX f = random_forces(24, 68);
+  const auto fresh = [&](const std::vector<sc::Pose>& poses) {
+    sc::MultiblobMobility m(shell, 4, options(sc::MultiblobSolver::dense));
+    m.set_configuration(poses);
+    return sc::VecX(m.apply(f));
+  };
+  sc::MultiblobMobility m(shell, 4, options(sc::MultiblobSolver::dense));
+  m.set_configuration(a);
+  const sc::VecX u_a = m.apply(f);
+  EXPECT_EQ(u_a, fresh(a));
+  m.set_configuration(b);  // replaced before any apply
+  m.set_configuration(c);
+  EXPECT_EQ(m.apply(f), fresh(c));
+  EXPECT_GT((fresh(c) - u_a).norm(), 1e-3 * u_a.norm());  // the configurations differ
+  m.set_configuration(a);
+  EXPECT_EQ(sc::VecX(m.dense_matrix() * f), u_a);
+  EXPECT_EQ(m.apply(f), u_a);
+}
+
+// adaptive: GMRES until the configuration's products reach adaptive_products_per_blob x
+// blobs, then the dense factorisation, again from GMRES after each set_configuration.
+TEST(MultiblobMobility, AdaptiveFactorisesOnceItsProductBudgetIsSpent) {
+  const sc::BlobModel shell = sc::sphere_shell(12, 1.0);
+  const auto poses = lattice_poses(4, 3.0, 69), other = lattice_poses(4, 2.8, 70);
+  const sc::VecX f = random_forces(24, 71);
+  sc::MultiblobMobility dense(shell, 4, options(sc::MultiblobSolver::dense));
+  dense.set_configuration(poses);
+  const sc::VecX exact = dense.apply(f);
+
+  sc::MultiblobOptions o = options(sc::MultiblobSolver::adaptive, 1e-10);
+  o.adaptive_products_per_blob = 0.1;  // 4 products for 48 blobs: the first apply spends more
+  sc::MultiblobMobility m(shell, 4, o);
+  EXPECT_EQ(m.solver(), sc::MultiblobSolver::adaptive);
+  m.set_configuration(poses);
+  const sc::VecX first = m.apply(f);
+  EXPECT_GT(m.last_iterations(), 4);
+  EXPECT_FALSE(m.factorised());
+  EXPECT_LT((first - exact).norm(), 1e-8 * exact.norm());
+  const std::size_t iterations = m.total_iterations();
+  EXPECT_EQ(m.apply(f), exact);  // factorised now: the dense path's own numbers
+  EXPECT_TRUE(m.factorised());
+  EXPECT_EQ(m.last_iterations(), 0);
+  EXPECT_EQ(m.total_iterations(), iterations);
+  EXPECT_EQ(m.applications(), 2u);
+
+  m.set_configuration(other);  // a new configuration starts on GMRES again
+  EXPECT_FALSE(m.factorised());
+  m.apply(f);
+  EXPECT_GT(m.total_iterations(), iterations);
+
+  o.adaptive_products_per_blob = 0.0;  // factorise at once
+  sc::MultiblobMobility at_once(shell, 4, o);
+  at_once.set_configuration(poses);
+  EXPECT_EQ(at_once.apply(f), exact);
+  EXPECT_EQ(at_once.total_iterations(), 0u);
+
+  o.dense_max_blobs = 0;  // automatic's bound does not apply to adaptive
+  EXPECT_EQ(sc::MultiblobMobility(shell, 4, o).solver(), sc::MultiblobSolver::adaptive);
+  o.adaptive_max_blobs = 47;  // too many blobs to factorise: matrix-free throughout
+  EXPECT_EQ(sc::MultiblobMobility(shell, 4, o).solver(), sc::MultiblobSolver::matrix_free);
+  o.adaptive_max_blobs = 48;
+  EXPECT_EQ(sc::MultiblobMobility(shell, 4, o).solver(), sc::MultiblobSolver::adaptive);
+  o.adaptive_max_blobs = -1;
+  expect_rejects([&] { sc::MultiblobMobility(shell, 4, o); }, "adaptive_max_blobs");
+  o.adaptive_max_blobs = 48;
+  o.adaptive_products_per_blob = -1.0;
+  expect_rejects([&] { sc::MultiblobMobility(shell, 4, o); }, "adaptive_products_per_blob");
+}
+
 TEST(MultiblobMobility, CountsApplicationsAndGmresIterations) {
   sc::MultiblobMobility dense(sc::sphere_shell(12, 1.0), 4, options(sc::MultiblobSolver::dense));
   sc::MultiblobMobility free(sc::sphere_shell(12, 1.0), 4, options(sc::MultiblobSolver::matrix_free));
@@ -281,6 +356,14 @@ TEST(MultiblobMobility, AutomaticSolverChoosesByBlobCount) {
   o.dense_max_blobs = 100;
   EXPECT_TRUE(sc::MultiblobMobility(sc::sphere_shell(12, 1.0), 8, o).uses_dense());    // 96 blobs
   EXPECT_FALSE(sc::MultiblobMobility(sc::sphere_shell(12, 1.0), 9, o).uses_dense());   // 108 blobs
+}
+
+TEST(MultiblobMobility, SolverNamesRoundTripAndUnknownNamesAreRefusedByField) {
+  for (const auto s : {sc::MultiblobSolver::automatic, sc::MultiblobSolver::dense, sc::MultiblobSolver::matrix_free,
+                       sc::MultiblobSolver::adaptive})
+    EXPECT_EQ(sc::multiblob_solver_from_name(sc::multiblob_solver_name(s), "solver"), s);
+  EXPECT_STREQ(sc::multiblob_solver_name(sc::MultiblobSolver::matrix_free), "matrix-free");
+  expect_rejects([] { sc::multiblob_solver_from_name("matrix_free", "--multiblob-solver"); }, "--multiblob-solver");
 }
 
 TEST(MultiblobMobility, RejectsBadInputWithoutChangingState) {

@@ -4,14 +4,28 @@
 // the overlap branch, blob motions rigid. The body mobility is N = (K^T M^-1 K)^-1, 6N x 6N,
 // world frame, rows (u_i, omega_i), columns (f_i, tau_i) about each body's origin.
 //
-// Two paths, chosen by MultiblobOptions::solver:
-//  - dense: set_configuration assembles M for all blobs, factorises it (Cholesky) and forms
-//    N once; apply is one 6N x 6N product. For small systems.
+// Two paths, chosen by MultiblobOptions::solver (or both, adaptive):
+//  - dense: the first apply after set_configuration assembles M for all blobs, factorises it
+//    (Cholesky) and forms N; every apply is then one 6N x 6N product. For small systems. The
+//    factorisation waits for an apply because a configuration may need none (a contact step
+//    with no flagged pair sets the configuration and applies nothing).
 //  - matrix_free: apply solves the saddle-point system of multiblob_saddle_point.hpp with
 //    right-preconditioned GMRES (block-diagonal preconditioner), the RPY products summed
 //    directly without forming M. Iterations of the last apply and in total are reported; an
 //    apply that misses the tolerance throws std::runtime_error rather than return a wrong U.
 //  automatic picks dense when the scene has at most dense_max_blobs blobs.
+//  adaptive (up to adaptive_max_blobs blobs; matrix-free beyond): each configuration starts
+//  matrix-free and is factorised once its GMRES has spent adaptive_products_per_blob x blobs
+//  RPY products, about what the factorisation costs, so no configuration costs much more
+//  than twice the cheaper path (the ski-rental rule), whichever it is. The switch counts
+//  products, not seconds, so the same inputs take the same path on any machine.
+//  Which path is cheaper depends on how many applications a configuration gets and how fast
+//  GMRES converges, not on the blob count alone. Measured (docs/results.md): for the 30
+//  multiblob rods of Fig. 8 (1380 blobs, gaps down to 0.005 against a blob radius of 0.19)
+//  dense costs 2.3 s per contact step (the factorisation; 74 applications), matrix-free 6-15 s
+//  (GMRES converges slowly for bodies this close) and adaptive 6.4 s (one thread, dense 2.4 s
+//  in the same run); for loose 12-blob shells the dense set-up takes 6.8 s at 1992 blobs, a
+//  matrix-free apply 29 ms at 1536 (15 GMRES iterations).
 //
 // Rules: all models must share one blob radius (RPY here is the equal-radius tensor); bodies
 // may overlap, as the contact code's trial configurations can (RPY's overlap branch keeps M
@@ -22,6 +36,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "stokescontact/core/gmres.hpp"
@@ -31,18 +46,51 @@
 
 namespace stokescontact {
 
-enum class MultiblobSolver { automatic, dense, matrix_free };
+enum class MultiblobSolver { automatic, dense, matrix_free, adaptive };
+
+inline const char* multiblob_solver_name(MultiblobSolver solver) {
+  switch (solver) {
+    case MultiblobSolver::automatic: return "automatic";
+    case MultiblobSolver::dense: return "dense";
+    case MultiblobSolver::matrix_free: return "matrix-free";
+    case MultiblobSolver::adaptive: return "adaptive";
+  }
+  return "?";
+}
+
+// The solver named `name` ("automatic", "dense", "matrix-free", "adaptive"); anything else is
+// refused naming `field`.
+inline MultiblobSolver multiblob_solver_from_name(std::string_view name, std::string_view field) {
+  for (MultiblobSolver s : {MultiblobSolver::automatic, MultiblobSolver::dense, MultiblobSolver::matrix_free,
+                            MultiblobSolver::adaptive})
+    if (name == multiblob_solver_name(s)) return s;
+  fail_argument(field, "unknown multiblob solver '" + std::string(name) +
+                           "' (known: automatic, dense, matrix-free, adaptive)");
+}
 
 struct MultiblobOptions {
   double viscosity = 1.0;
   MultiblobSolver solver = MultiblobSolver::automatic;
-  Eigen::Index dense_max_blobs = 1000;  // automatic: dense up to this many blobs in the scene
+  // automatic: dense up to this many blobs in the scene (it factorises every configuration,
+  // needed or not). The dense path holds about two (3 blobs)^2 matrices of doubles while it
+  // factorises: 0.14 GB at 1000 blobs.
+  Eigen::Index dense_max_blobs = 1000;
+  // adaptive: may factorise up to this many blobs (a memory bound only, as adaptive pays the
+  // factorisation only where GMRES would cost more): 1.3 GB at 3000 blobs.
+  Eigen::Index adaptive_max_blobs = 3000;
+  // adaptive: RPY products per blob after which a configuration is factorised. The dense
+  // set-up cost about 1.2 x blobs products in both measurements above (6.8 s against 2.9 ms
+  // a product at 1992 blobs, 2.3 s against 1.4 ms at 1380; the products from
+  // bench_multiblob's 1536-blob apply, scaled by blobs^2).
+  double adaptive_products_per_blob = 1.2;
   // Relative residual of the blob-unit saddle-point system; restart and iteration limits.
   GmresOptions gmres{1e-8, 1000, 100};
 
   void validate() const {
     require_positive(viscosity, "MultiblobOptions.viscosity");
     if (dense_max_blobs < 0) fail_argument("MultiblobOptions.dense_max_blobs", "must be >= 0");
+    if (adaptive_max_blobs < 0) fail_argument("MultiblobOptions.adaptive_max_blobs", "must be >= 0");
+    require_non_negative(adaptive_products_per_blob, "MultiblobOptions.adaptive_products_per_blob");
     gmres.validate();
   }
 };
@@ -75,8 +123,10 @@ class MultiblobMobility {
       system_.first_blob.push_back(system_.first_blob.back() + models_[body_models_[i]].size());
       system_.bodies.push_back(&self_[body_models_[i]]);
     }
+    const Eigen::Index blobs = system_.first_blob.back();
     dense_ = options_.solver == MultiblobSolver::dense ||
-             (options_.solver == MultiblobSolver::automatic && system_.first_blob.back() <= options_.dense_max_blobs);
+             (options_.solver == MultiblobSolver::automatic && blobs <= options_.dense_max_blobs);
+    adaptive_ = options_.solver == MultiblobSolver::adaptive && blobs <= options_.adaptive_max_blobs;
   }
 
   // `bodies` bodies, all of one model.
@@ -89,7 +139,9 @@ class MultiblobMobility {
   MultiblobMobility(MultiblobMobility&&) noexcept = default;
   MultiblobMobility& operator=(MultiblobMobility&&) noexcept = default;
 
-  // New poses, same bodies. Validates everything before changing anything.
+  // New poses, same bodies. Validates everything before changing anything; on the dense path
+  // the factorisation is left to the first apply (which throws std::invalid_argument naming
+  // `poses` if M is not positive definite there).
   void set_configuration(std::span<const Pose> poses) {
     const std::size_t n = body_models_.size();
     validate(poses, n);
@@ -107,9 +159,10 @@ class MultiblobMobility {
       next.blobs.middleCols(begin, m.size()) = next.offsets.middleCols(begin, m.size()).colwise() + poses[i].x / a_;
     }
     require_separated_blobs(next.blobs);
-    if (dense_) dense_mobility_ = dense_body_mobility(next);
     system_ = std::move(next);
     configured_ = true;
+    factorised_ = false;
+    configuration_products_ = 0;
   }
 
   // U = N F, one application.
@@ -117,15 +170,18 @@ class MultiblobMobility {
     require_configured();
     require_finite(F, size(), "F");
     counter_.count();
-    if (dense_) return dense_mobility_ * F;
+    if (dense_ || (adaptive_ && (factorised_ || configuration_products_ >= adaptive_switch_products()))) {
+      last_iterations_ = 0;
+      return factorised_mobility() * F;
+    }
     return solve_matrix_free(F);
   }
 
-  // Dense path: N as formed in set_configuration (0 applications). Matrix-free: N assembled
-  // column by column (size() applications) and symmetrised.
+  // Dense and adaptive paths: N factorised (0 applications). Matrix-free: N assembled column
+  // by column (size() applications) and symmetrised.
   MatX dense_matrix() {
     require_configured();
-    if (dense_) return dense_mobility_;
+    if (dense_ || adaptive_) return factorised_mobility();
     MatX N(size(), size());
     for (Eigen::Index j = 0; j < size(); ++j) N.col(j) = apply(VecX::Unit(size(), j));
     return 0.5 * (N + N.transpose());
@@ -140,6 +196,12 @@ class MultiblobMobility {
   }
 
   bool uses_dense() const { return dense_; }
+  // The path taken: dense, matrix_free or (up to adaptive_max_blobs blobs) adaptive; never automatic.
+  MultiblobSolver solver() const {
+    return dense_ ? MultiblobSolver::dense : adaptive_ ? MultiblobSolver::adaptive : MultiblobSolver::matrix_free;
+  }
+  // adaptive: whether the current configuration has been factorised.
+  bool factorised() const { return factorised_; }
   Eigen::Index blob_count() const { return system_.first_blob.back(); }
   double blob_radius() const { return a_; }
   // GMRES diagnostics of the matrix-free path (0 on the dense path).
@@ -170,6 +232,15 @@ class MultiblobMobility {
     return static_cast<std::size_t>(it - system_.first_blob.begin()) - 1;
   }
 
+  // Dense path: N of the current configuration, formed on the first call after it was set.
+  const MatX& factorised_mobility() {
+    if (!factorised_) {
+      dense_mobility_ = dense_body_mobility(system_);
+      factorised_ = true;
+    }
+    return dense_mobility_;
+  }
+
   // N = mu0 S (K^T M^-1 K)^-1 S in world frame, by one Cholesky of the blob-unit M.
   MatX dense_body_mobility(const MultiblobSaddlePoint& s) const {
     const Eigen::LLT<MatX> m_factor(rpy_blob_matrix(s.blobs));
@@ -185,6 +256,10 @@ class MultiblobMobility {
     return 0.5 * (N + N.transpose());
   }
 
+  std::size_t adaptive_switch_products() const {
+    return static_cast<std::size_t>(options_.adaptive_products_per_blob * static_cast<double>(blob_count()));
+  }
+
   VecX body_unit_scale() const {
     return blob_unit_scale(a_).replicate(static_cast<Eigen::Index>(body_models_.size()), 1);
   }
@@ -197,6 +272,7 @@ class MultiblobMobility {
                                      [this](const VecX& v) { return system_.precondition(v); }, options_.gmres);
     last_iterations_ = result.iterations;
     last_residual_ = result.relative_residual;
+    configuration_products_ += static_cast<std::size_t>(result.operator_applications);
     total_iterations_ += static_cast<std::size_t>(result.iterations);
     if (!result.converged)
       throw std::runtime_error("MultiblobMobility: GMRES stopped at relative residual " +
@@ -215,6 +291,9 @@ class MultiblobMobility {
   MultiblobSaddlePoint system_;
   bool dense_ = false;
   bool configured_ = false;
+  bool adaptive_ = false;
+  bool factorised_ = false;  // dense_mobility_ belongs to the current configuration
+  std::size_t configuration_products_ = 0;  // RPY products of GMRES in the current configuration
   MatX dense_mobility_;
   ApplicationCounter counter_;
   int last_iterations_ = 0;
