@@ -8,7 +8,7 @@
 //   brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]
 //                 [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]
 //                 [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]
-//                 [--start random|aligned] [--melt 0]
+//                 [--overlap-ends-angle 0.1] [--start random|aligned] [--melt 0]
 //                 [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]
 //                 [--output FILE]
 //
@@ -23,7 +23,8 @@
 // Every (U0, dt) runs from that start; given several --dt, a row "dt -> 0" per U0
 // extrapolates Z = Z_0 + c sqrt(dt) (brownian_pressure.hpp). --directions: the contact
 // directions (overlap-ends holds near-parallel rods at both ends of their overlap, when it is
-// at least --overlap-ends-min-overlap times the radius: ContactStepOptions::overlap_ends_min_overlap);
+// at least --overlap-ends-min-overlap times the radius: ContactStepOptions::overlap_ends_min_overlap,
+// and their axes meet at less than --overlap-ends-angle radians: overlap_ends_angle);
 // --max-substep-halvings: TimeStepperOptions::max_substep_halvings (0: a step the solver
 // fails ends the run at once, with the solver's message). Per run, the collision pressure is
 // reported as Yan's
@@ -76,6 +77,7 @@ constexpr const char* kUsage =
     "usage: brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]\n"
     "                     [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]\n"
     "                     [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]\n"
+    "                     [--overlap-ends-angle 0.1]\n"
     "                     [--start random|aligned] [--melt 0]\n"
     "                     [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]\n"
     "                     [--output FILE]\n";
@@ -94,6 +96,7 @@ struct Options {
   std::string solver = "default";
   ex::RodDirections directions = ex::RodDirections::particle;
   double min_overlap = sc::ContactStepOptions{}.overlap_ends_min_overlap;
+  double ends_angle = sc::ContactStepOptions{}.overlap_ends_angle;
   std::uint64_t seed = 1;
   double tolerance = 0.0;
   std::string output;
@@ -121,6 +124,7 @@ Options parse(int argc, char** argv) {
   if (o.directions == ex::RodDirections::line)
     throw std::invalid_argument("--directions line needs line-contact rods; use particle, surface or overlap-ends");
   o.min_overlap = args.number("--overlap-ends-min-overlap", o.min_overlap, 1e-12);
+  o.ends_angle = args.number("--overlap-ends-angle", o.ends_angle, 1e-12);
   o.start = args.text("--start", "random");
   if (o.start != "random" && o.start != "aligned")
     throw std::invalid_argument("--start must be random or aligned, got '" + o.start + "'");
@@ -181,6 +185,7 @@ std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, cons
   options.box = sc::PeriodicBox{sc::Vec3::Constant(s.side)};
   options.contact_step.directions = ex::contact_directions(o.directions);
   options.contact_step.overlap_ends_min_overlap = o.min_overlap;
+  options.contact_step.overlap_ends_angle = o.ends_angle;
   options.max_substep_halvings = o.halvings;
   options.brownian.emplace();
   options.brownian->kT = 1.0;
@@ -274,7 +279,8 @@ int run(const Options& o) {
                 ", \"u0\": " + sc::json_number(u0) + ", \"D_R\": " + sc::json_number(s.D_R) + ", \"dt_D_R\": " +
                 sc::json_number(dt_D_R) + ", \"d_hat\": " + sc::json_number(o.d_hat) + ", \"solver\": \"" +
                 o.solver + "\", \"directions\": \"" + ex::directions_name(o.directions) +
-                "\", \"overlap_ends_min_overlap\": " + sc::json_number(o.min_overlap) + ", \"seed\": " +
+                "\", \"overlap_ends_min_overlap\": " + sc::json_number(o.min_overlap) +
+                ", \"overlap_ends_angle\": " + sc::json_number(o.ends_angle) + ", \"seed\": " +
                 std::to_string(o.seed) + ", \"steps_averaged\": " +
                 std::to_string(r.steps) + ", \"B2n\": " + sc::json_number(b2n) + ", \"Z\": " + sc::json_number(z) +
                 ", \"Z_error\": " + sc::json_number(z_error) + ", \"pressure_ratio\": " + sc::json_number(ratio) +
