@@ -366,6 +366,54 @@ TEST(ContactMatrix, RejectsBadInput) {
                  "SurfaceWeights.min_net_force_fraction");
   const std::vector<sc::ContactColumn> columns = {{0, 2}};
   expect_rejects([&] { sc::assemble_contact_matrix(columns, 2, 6); }, "columns[0]");
+  const std::vector<sc::ContactColumn> same_body = {{0, 1}, {1, 1}};
+  expect_rejects([&] { sc::assemble_contact_matrix(same_body, 2, 3); }, "columns[1]");
+}
+
+// assemble_contact_matrix fills compressed column storage directly: the same matrix, entry
+// for entry (explicit zeros and the order of each column's rows included), as the triplets
+// of its definition through Eigen's setFromTriplets; pairs given as (i, j) and as (j, i).
+TEST(ContactMatrix, AssemblyIsTheTripletsMatrixEntryForEntry) {
+  std::mt19937_64 rng(31);
+  for (const int dofs : {3, 6}) {
+    const std::size_t bodies = 40;
+    std::vector<sc::ContactColumn> columns;
+    for (int k = 0; k < 300; ++k) {
+      const auto i = static_cast<Eigen::Index>(rng() % bodies);
+      const auto j = static_cast<Eigen::Index>((static_cast<std::size_t>(i) + 1 + rng() % (bodies - 1)) % bodies);
+      sc::ContactColumn c{i, j, uniform_vector(rng, -1.0, 1.0), uniform_vector(rng, -1.0, 1.0),
+                          uniform_vector(rng, -1.0, 1.0)};
+      if (k % 7 == 0) c.force_j.y() = 0.0;  // an explicit zero stays an entry
+      columns.push_back(c);
+    }
+    std::vector<Eigen::Triplet<double>> entries;
+    for (std::size_t k = 0; k < columns.size(); ++k) {
+      const sc::ContactColumn& c = columns[k];
+      const auto col = static_cast<Eigen::Index>(k);
+      for (int r = 0; r < 3; ++r) {
+        entries.emplace_back(c.i * dofs + r, col, -c.force_j[r]);
+        entries.emplace_back(c.j * dofs + r, col, c.force_j[r]);
+        if (dofs == 6) {
+          entries.emplace_back(c.i * dofs + 3 + r, col, c.torque_i[r]);
+          entries.emplace_back(c.j * dofs + 3 + r, col, c.torque_j[r]);
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> expected(static_cast<Eigen::Index>(bodies) * dofs,
+                                         static_cast<Eigen::Index>(columns.size()));
+    expected.setFromTriplets(entries.begin(), entries.end());
+    const Eigen::SparseMatrix<double> d = sc::assemble_contact_matrix(columns, bodies, dofs);
+    ASSERT_EQ(d.rows(), expected.rows());
+    ASSERT_EQ(d.cols(), expected.cols());
+    ASSERT_EQ(d.nonZeros(), expected.nonZeros());
+    ASSERT_TRUE(d.isCompressed());
+    for (Eigen::Index k = 0; k <= d.cols(); ++k) EXPECT_EQ(d.outerIndexPtr()[k], expected.outerIndexPtr()[k]);
+    for (Eigen::Index e = 0; e < d.nonZeros(); ++e) {
+      EXPECT_EQ(d.innerIndexPtr()[e], expected.innerIndexPtr()[e]) << "entry " << e << ", dofs " << dofs;
+      EXPECT_EQ(d.valuePtr()[e], expected.valuePtr()[e]) << "entry " << e << ", dofs " << dofs;
+    }
+  }
+  EXPECT_EQ(sc::assemble_contact_matrix({}, 5, 6).nonZeros(), 0);
 }
 
 }  // namespace contact_matrix_tests

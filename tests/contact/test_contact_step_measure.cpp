@@ -1,7 +1,9 @@
 // The contact step's cheap measurements give the numbers of its full ones (contact_step.hpp):
 //   - ContactStep::min_distance_at (a ray sample of the default solver: only the moved bodies'
 //     pairs measured again, no configuration formed) equals measure(...).min_distance(), bit
-//     for bit, and leaves the step's state as it was;
+//     for bit, and leaves the step's state as it was; separated_at (the same sample, its
+//     witness pairs measured first) answers min d >= target exactly, at targets on either
+//     side of the minimum;
 //   - after pairs are added (rebuild computes only the new pairs' columns and measurements at
 //     Q*), every pair's measurement at Q* is its distance computed afresh there;
 //   - the result's min_distance_ratio (read from the end check's broad phase, or from
@@ -15,6 +17,7 @@
 // each other in the trial step (carried contacts), with particle and overlap-ends directions.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numbers>
@@ -157,6 +160,11 @@ void expect_min_distance_at_is_measure(const Scene<S>& s, const sc::ContactStepO
       const double full = measured.min_distance();
       EXPECT_EQ(step.min_distance_at(MD), full) << "sample " << sample;
       EXPECT_EQ(step.min_distance_at(MD), full) << "sample " << sample << ", called again";
+      // separated_at answers min d >= target, whatever its witnesses from earlier calls: at
+      // the minimum itself, just above and below it, and at targets every pair or none meets.
+      for (const double target : {full, std::nextafter(full, 1e300), std::nextafter(full, -1e300), full - 1.0,
+                                  full + 1.0, full + 1e-3 * kDHat})
+        EXPECT_EQ(step.separated_at(MD, target), full >= target) << "sample " << sample << ", target " << target;
       expect_same_evaluation(step.evaluate(lambda), measured);  // in the last one's storage
       ++sample;
     }

@@ -9,7 +9,10 @@
 #include <cstddef>
 #include <cstdio>
 #include <numbers>
+#include <random>
+#include <optional>
 #include <set>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -22,6 +25,8 @@
 #include "stokescontact/mobility/boomerang_blobs.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/mobility/single_body_mobility.hpp"
+#include "stokescontact/scenes/periodic_placement.hpp"
+#include "stokescontact/scenes/random.hpp"
 #include "stokescontact/scenes/sphere_packing.hpp"
 
 // The whole file in its own namespace: tests of one layer are compiled together (unity build).
@@ -93,6 +98,82 @@ TEST(SweptDistance, SpheresHaveTheClosedFormNearestApproach) {
   EXPECT_TRUE(f.below);
   EXPECT_NEAR(f.time, (3.0 - std::sqrt(3.75)) / 4.0, 1e-14);
   EXPECT_FALSE(sc::first_time_below(s, pa, va, s, pb, vb, 0.1, 0.0, 1e-12).below);
+}
+
+// trajectory_crossings within a CrossingScope finds what the whole check finds, when the
+// unscoped pairs are those the trial step did not flag (DTryRule::relative) and the scope's
+// moved bodies are those whose velocity differs from the trial one: the contact step's
+// guarantee after a correction. Spheres in open space (with a few bodies fast enough for
+// the broad phase's all-against-one path) and rods turning in a periodic box; trial motions
+// that pass pairs through each other and corrections that do, so that both the flagged pairs
+// of unmoved bodies and the moved bodies' pairs cross. Crossings compared field by field.
+template <sc::Shape S>
+void expect_scoped_crossings_are_all(std::span<const S> shapes, std::span<const sc::Pose> poses, const sc::VecX& U,
+                                     int dofs, double dt, const std::optional<sc::PeriodicBox>& box, sc::Rng& rng) {
+  const std::vector<sc::Pose> trial = sc::advance_all(poses, U, dofs, dt);
+  const sc::RelativePairs flagged = sc::find_pairs_relative(shapes, std::span<const sc::Pose>(trial), U, dofs, dt,
+                                                            kDHat, 1.0, box);
+  std::vector<sc::BodyPair> flagged_pairs;
+  for (const sc::ContactPair& p : flagged.pairs) flagged_pairs.push_back({p.i, p.j});
+  for (const double fraction : {0.0, 0.1, 0.5}) {
+    sc::VecX V = U;
+    std::vector<char> moved(poses.size(), 0);
+    for (std::size_t b = 0; b < poses.size(); ++b) {
+      if (std::uniform_real_distribution<double>(0.0, 1.0)(rng) >= fraction) continue;
+      moved[b] = 1;
+      V.segment<3>(static_cast<Eigen::Index>(b) * dofs) += (1.5 / dt) * sc::random_unit_vector(rng);
+      if (dofs == 6) V.segment<3>(static_cast<Eigen::Index>(b) * dofs + 3) += (1.0 / dt) * sc::random_unit_vector(rng);
+    }
+    const sc::CrossingScope scope{moved, flagged_pairs};
+    for (const double threshold : {-kMargin * kDHat, 0.5 * kDHat}) {
+      SCOPED_TRACE("moved fraction " + std::to_string(fraction) + ", threshold " + std::to_string(threshold));
+      const std::vector<sc::TrajectoryCrossing> all =
+          sc::trajectory_crossings(shapes, poses, V, dofs, dt, threshold, 1e-4 * kDHat, box);
+      sc::CellList cells;
+      const std::vector<sc::TrajectoryCrossing> scoped =
+          sc::trajectory_crossings(shapes, poses, V, dofs, dt, threshold, 1e-4 * kDHat, box, &cells, &scope);
+      ASSERT_GT(all.size(), 0u);
+      ASSERT_EQ(scoped.size(), all.size());
+      bool unmoved_crossing = false;
+      for (std::size_t k = 0; k < all.size(); ++k) {
+        EXPECT_EQ(scoped[k].i, all[k].i);
+        EXPECT_EQ(scoped[k].j, all[k].j);
+        EXPECT_TRUE(scoped[k].image_shift == all[k].image_shift);
+        EXPECT_EQ(scoped[k].first.time, all[k].first.time);
+        EXPECT_EQ(scoped[k].first.points.distance, all[k].first.points.distance);
+        unmoved_crossing |= !moved[static_cast<std::size_t>(all[k].i)] && !moved[static_cast<std::size_t>(all[k].j)];
+      }
+      EXPECT_TRUE(unmoved_crossing) << "the trial motion must pass some pair through";
+    }
+  }
+}
+
+TEST(NoTunnelling, ScopedCrossingsAreEveryCrossingAfterACorrection) {
+  sc::Rng rng(41);
+  {
+    const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+    const std::vector<sc::Pose> poses = sc::random_sequential_addition(800, 0.3, 41).poses;
+    const double dt = 0.01;
+    sc::VecX U(3 * static_cast<Eigen::Index>(poses.size()));
+    for (std::size_t b = 0; b < poses.size(); ++b)  // up to 1.5 radii per step, three bodies 6
+      U.segment<3>(3 * static_cast<Eigen::Index>(b)) = ((b % 300 == 0 ? 6.0 : 1.5) / dt) * sc::random_unit_vector(rng);
+    expect_scoped_crossings_are_all(std::span<const sc::Sphere>(shapes), std::span<const sc::Pose>(poses), U, 3, dt,
+                                    std::nullopt, rng);
+  }
+  {
+    const sc::Spherocylinder rod{1.0, 0.2};
+    const double side = 12.0;
+    const std::vector<sc::Pose> poses = sc::periodic_random_placement(rod, 150, side, 0.01, 42);
+    const double dt = 0.01;
+    sc::VecX U(6 * static_cast<Eigen::Index>(poses.size()));
+    for (std::size_t b = 0; b < poses.size(); ++b) {
+      U.segment<3>(6 * static_cast<Eigen::Index>(b)) = (0.5 / dt) * sc::random_unit_vector(rng);
+      U.segment<3>(6 * static_cast<Eigen::Index>(b) + 3) = (0.8 / dt) * sc::random_unit_vector(rng);
+    }
+    const std::vector<sc::Spherocylinder> shapes{rod};
+    expect_scoped_crossings_are_all(std::span<const sc::Spherocylinder>(shapes), std::span<const sc::Pose>(poses), U, 6,
+                                    dt, sc::PeriodicBox{sc::Vec3::Constant(side)}, rng);
+  }
 }
 
 struct HeadOn {

@@ -35,12 +35,23 @@ std::vector<BodyPair> brute_force(const Mat3X& x, const VecX& r, double cutoff, 
   return pairs;
 }
 
-// Cell list == brute force, both for a fresh object and for one reused across scenes.
+// Cell list == brute force, both for a fresh object and for one reused across scenes; and
+// find_pairs_of == the brute-force pairs with a marked body, for none, a few, about half and
+// all bodies marked.
 void expect_matches_brute_force(CellList& reused, const Mat3X& x, const VecX& r, double cutoff,
                                 const Box& box = {}) {
   const std::vector<BodyPair> expected = brute_force(x, r, cutoff, box);
   EXPECT_EQ(candidate_pairs(x, r, cutoff, box), expected);
   EXPECT_EQ(reused.find_pairs(x, r, cutoff, box), expected);
+  std::mt19937_64 rng(static_cast<std::uint64_t>(x.cols()));
+  for (const double fraction : {0.0, 0.05, 0.5, 1.0}) {
+    std::vector<char> marked(static_cast<std::size_t>(x.cols()));
+    for (char& m : marked) m = std::uniform_real_distribution<double>(0.0, 1.0)(rng) < fraction;
+    std::vector<BodyPair> with_marked;
+    for (const BodyPair& p : expected)
+      if (marked[static_cast<std::size_t>(p.i)] || marked[static_cast<std::size_t>(p.j)]) with_marked.push_back(p);
+    EXPECT_EQ(reused.find_pairs_of(x, r, cutoff, box, marked), with_marked) << "marked fraction " << fraction;
+  }
 }
 
 Mat3X uniform_in(std::mt19937_64& rng, Eigen::Index n, const Vec3& lo, const Vec3& hi) {
@@ -257,6 +268,14 @@ TEST(BroadPhase, DistantOutliersStayCheap) {
   EXPECT_LT(cells.pair_checks(), 40 * n);
   EXPECT_EQ(pairs, brute_force(x, r, 0.1, {}));
   EXPECT_TRUE(std::find(pairs.begin(), pairs.end(), BodyPair{0, 4}) != pairs.end());
+  // The folded grid from the marked bodies' side: the outliers and every tenth body.
+  std::vector<char> marked(static_cast<std::size_t>(n), 0);
+  for (std::size_t k = 0; k < marked.size(); k += 10) marked[k] = 1;
+  marked[3] = marked[4] = 1;
+  std::vector<BodyPair> with_marked;
+  for (const BodyPair& p : pairs)
+    if (marked[static_cast<std::size_t>(p.i)] || marked[static_cast<std::size_t>(p.j)]) with_marked.push_back(p);
+  EXPECT_EQ(cells.find_pairs_of(x, r, 0.1, {}, marked), with_marked);
 }
 
 TEST(BroadPhase, RejectsBadInput) {
@@ -289,6 +308,8 @@ TEST(BroadPhase, RejectsBadInput) {
   expect_field([&] { candidate_pairs(x, r, 0.1, PeriodicBox{Vec3(10.0, 0.0, 10.0)}); }, "PeriodicBox.lengths");
   expect_field([&] { candidate_pairs(x, r, 0.1, PeriodicBox{Vec3(10.0, 10.0, -10.0)}); }, "PeriodicBox.lengths");
   expect_field([&] { candidate_pairs(x, r, 0.1, PeriodicBox{Vec3(10.0, inf, 10.0)}); }, "PeriodicBox.lengths");
+  CellList cells;
+  expect_field([&] { cells.find_pairs_of(x, r, 0.1, {}, std::vector<char>(3, 1)); }, "marked");
   // Validation comes first even when there is nothing to pair.
   expect_field([&] { candidate_pairs(Mat3X(3, 0), VecX(0), -1.0); }, "cutoff");
 }

@@ -153,25 +153,33 @@ inline Eigen::SparseMatrix<double> assemble_contact_matrix(std::span<const Conta
                                                            std::size_t bodies, int dofs_per_body) {
   if (dofs_per_body != 3 && dofs_per_body != 6)
     fail_argument("dofs_per_body", "must be 3 or 6, got " + std::to_string(dofs_per_body));
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(columns.size() * 2 * static_cast<std::size_t>(dofs_per_body));
-  for (std::size_t k = 0; k < columns.size(); ++k) {
-    const ContactColumn& c = columns[k];
-    detail::require_pair_indices(c.i, c.j, bodies, "columns[" + std::to_string(k) + "]");
-    const auto col = static_cast<Eigen::Index>(k);
-    const Eigen::Index row_i = c.i * dofs_per_body, row_j = c.j * dofs_per_body;
-    for (int r = 0; r < 3; ++r) {
-      entries.emplace_back(row_i + r, col, -c.force_j[r]);
-      entries.emplace_back(row_j + r, col, c.force_j[r]);
-      if (dofs_per_body == 6) {
-        entries.emplace_back(row_i + 3 + r, col, c.torque_i[r]);
-        entries.emplace_back(row_j + 3 + r, col, c.torque_j[r]);
+  // Compressed column storage filled directly, rows ascending within each column (the lower
+  // body's dofs first): what setFromTriplets makes of the same entries, without its sort.
+  const Eigen::Index per_body = dofs_per_body, per_column = 2 * per_body;
+  const auto nc = static_cast<Eigen::Index>(columns.size());
+  Eigen::SparseMatrix<double> d(static_cast<Eigen::Index>(bodies) * dofs_per_body, nc);
+  d.resizeNonZeros(nc * per_column);
+  int* const outer = d.outerIndexPtr();
+  int* const inner = d.innerIndexPtr();
+  double* const value = d.valuePtr();
+  for (Eigen::Index k = 0; k < nc; ++k) {
+    const ContactColumn& c = columns[static_cast<std::size_t>(k)];
+    const auto n = static_cast<Eigen::Index>(bodies);
+    if (!(0 <= c.i && c.i < n && 0 <= c.j && c.j < n && c.i != c.j))
+      detail::require_pair_indices(c.i, c.j, bodies, "columns[" + std::to_string(k) + "]");
+    outer[k] = static_cast<int>(k * per_column);
+    // Body b's entries: -force_j, torque_i (body i) or force_j, torque_j (body j).
+    const auto body_entries = [&](Eigen::Index b, Eigen::Index at) {
+      const bool is_i = b == c.i;
+      for (Eigen::Index r = 0; r < per_body; ++r) {
+        inner[at + r] = static_cast<int>(b * per_body + r);
+        value[at + r] = r < 3 ? (is_i ? -c.force_j[r] : c.force_j[r]) : (is_i ? c.torque_i[r - 3] : c.torque_j[r - 3]);
       }
-    }
+    };
+    body_entries(std::min(c.i, c.j), k * per_column);
+    body_entries(std::max(c.i, c.j), k * per_column + per_body);
   }
-  Eigen::SparseMatrix<double> d(static_cast<Eigen::Index>(bodies) * dofs_per_body,
-                                static_cast<Eigen::Index>(columns.size()));
-  d.setFromTriplets(entries.begin(), entries.end());
+  outer[nc] = static_cast<int>(nc * per_column);
   return d;
 }
 

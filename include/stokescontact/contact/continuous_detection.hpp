@@ -89,8 +89,10 @@ struct SweptBodies {
 // fast bodies would set the cell size for everyone (cells are 2 max radius + cutoff wide):
 // balls more than twice the largest body's own bounding radius are tested against every
 // body instead, O(N) each, as long as there are at most 64 of them.
+// With `marked` (one entry per body), only the pairs that have a marked body (CellList::find_pairs_of).
 inline std::vector<BodyPair> swept_candidates(const Mat3X& centres, const VecX& radii, double body_radius,
-                                              double cutoff, const std::optional<PeriodicBox>& box, CellList& list) {
+                                              double cutoff, const std::optional<PeriodicBox>& box, CellList& list,
+                                              std::span<const char> marked = {}) {
   const auto n = centres.cols();
   if (box && n > 0) {  // the broad phase's condition (2 max radius + cutoff <= half a side), as a motion's failure
     Eigen::Index widest = 0;
@@ -100,21 +102,28 @@ inline std::vector<BodyPair> swept_candidates(const Mat3X& centres, const VecX& 
                             "ball of radius " + std::to_string(r_max) + " reaches beyond half the shortest side " +
                             std::to_string(0.5 * box->lengths.minCoeff()));
   }
+  const auto find = [&](const Mat3X& x, const VecX& r, std::span<const char> m) -> const std::vector<BodyPair>& {
+    return marked.empty() ? list.find_pairs(x, r, cutoff, box) : list.find_pairs_of(x, r, cutoff, box, m);
+  };
+  const auto is_marked = [&](Eigen::Index k) { return marked.empty() || marked[static_cast<std::size_t>(k)]; };
   std::vector<Eigen::Index> slow, fast;
   for (Eigen::Index k = 0; k < n; ++k) (radii[k] > 2.0 * body_radius ? fast : slow).push_back(k);
-  if (fast.empty() || fast.size() > 64) return list.find_pairs(centres, radii, cutoff, box);
+  if (fast.empty() || fast.size() > 64) return find(centres, radii, marked);
   Mat3X slow_centres(3, static_cast<Eigen::Index>(slow.size()));
   VecX slow_radii(static_cast<Eigen::Index>(slow.size()));
+  std::vector<char> slow_marked;
   for (std::size_t k = 0; k < slow.size(); ++k) {
     slow_centres.col(static_cast<Eigen::Index>(k)) = centres.col(slow[k]);
     slow_radii[static_cast<Eigen::Index>(k)] = radii[slow[k]];
+    if (!marked.empty()) slow_marked.push_back(marked[static_cast<std::size_t>(slow[k])]);
   }
   std::vector<BodyPair> out;
-  for (const BodyPair& p : list.find_pairs(slow_centres, slow_radii, cutoff, box))
+  for (const BodyPair& p : find(slow_centres, slow_radii, slow_marked))
     out.push_back({slow[static_cast<std::size_t>(p.i)], slow[static_cast<std::size_t>(p.j)]});
   for (const Eigen::Index f : fast) {
     for (Eigen::Index k = 0; k < n; ++k) {
       if (k == f || (radii[k] > 2.0 * body_radius && k < f)) continue;  // fast pairs once
+      if (!is_marked(f) && !is_marked(k)) continue;
       if (is_candidate_pair(centres.col(f), centres.col(k), radii[f], radii[k], cutoff, box))
         out.push_back({std::min(f, k), std::max(f, k)});
     }
@@ -163,13 +172,26 @@ struct TrajectoryCrossing {
   SweptDistance first;              // first_time_below's answer (below = true)
 };
 
+// Where a motion can cross: the pairs with a body marked in `moved` (one entry per body) and
+// the listed `pairs` (i < j, each once). trajectory_crossings given a scope tests only those, and
+// returns the same crossings as without it when no other pair can cross: the contact step's
+// guarantee after a correction of the trial motion with DTryRule::relative, where `moved` marks
+// the bodies the correction moves and `pairs` are the flagged pairs. A pair of two bodies on
+// their trial motion that was not flagged stays above d_hat over the whole step
+// (find_pairs_relative), so it cannot reach a threshold below d_hat.
+struct CrossingScope {
+  std::span<const char> moved;
+  std::span<const BodyPair> pairs;
+};
+
 // Every pair (i < j) whose d^P along Q_t + t' Psi V drops to `threshold` for some t' in
-// [0, dt], found within `tolerance` (a pair that comes within tolerance of it counts).
+// [0, dt], found within `tolerance` (a pair that comes within tolerance of it counts); with a
+// scope, among the scope's pairs only.
 template <Shape S>
 std::vector<TrajectoryCrossing> trajectory_crossings(std::span<const S> shapes, std::span<const Pose> poses,
                                                      const VecX& V, int dofs_per_body, double dt, double threshold,
                                                      double tolerance, const std::optional<PeriodicBox>& box = {},
-                                                     CellList* cells = nullptr) {
+                                                     CellList* cells = nullptr, const CrossingScope* scope = nullptr) {
   detail::SweptBodies<S> b(shapes, poses, V, dofs_per_body);
   require_positive(dt, "dt");
   require_finite(threshold, "threshold");
@@ -184,7 +206,26 @@ std::vector<TrajectoryCrossing> trajectory_crossings(std::span<const S> shapes, 
   CellList& list = cells != nullptr ? *cells : local;
   std::vector<TrajectoryCrossing> out;
   const double cutoff = std::max(0.0, threshold) + tolerance;
-  for (const BodyPair& c : detail::swept_candidates(b.centres, b.radii, b.body_radius, cutoff, box, list)) {
+  if (scope && static_cast<std::size_t>(scope->moved.size()) != poses.size())
+    fail_argument("CrossingScope.moved", "has " + std::to_string(scope->moved.size()) + " entries for " +
+                                             std::to_string(poses.size()) + " bodies");
+  std::vector<BodyPair> candidates =
+      detail::swept_candidates(b.centres, b.radii, b.body_radius, cutoff, box, list, scope ? scope->moved : std::span<const char>{});
+  if (scope) {  // the listed pairs of two unmoved bodies, through the broad phase's own test
+    const auto moved = [&](Eigen::Index k) { return scope->moved[static_cast<std::size_t>(k)] != 0; };
+    for (const BodyPair& p : scope->pairs) {
+      const auto n = static_cast<Eigen::Index>(poses.size());
+      if (!(0 <= p.i && p.i < n && 0 <= p.j && p.j < n && p.i != p.j))
+        fail_argument("CrossingScope.pairs", "(" + std::to_string(p.i) + ", " + std::to_string(p.j) +
+                                                 ") must be distinct indices into poses, N = " + std::to_string(n));
+      if (!moved(p.i) && !moved(p.j) &&
+          is_candidate_pair(b.centres.col(p.i), b.centres.col(p.j), b.radii[p.i], b.radii[p.j], cutoff, box))
+        candidates.push_back(p.i < p.j ? p : BodyPair{p.j, p.i});
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  }
+  for (const BodyPair& c : candidates) {
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const Vec3 shift = minimum_image_shift(b.centres.col(c.i), b.centres.col(c.j), box);
     SweptDistance first = first_time_below(shape_of(shapes, i), poses[i], v[i], shape_of(shapes, j),

@@ -9,6 +9,7 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -69,17 +70,18 @@ class CellList {
   // All candidate pairs (i < j), lexicographically sorted; valid until the next call.
   const std::vector<BodyPair>& find_pairs(const Mat3X& positions, const VecX& radii, double cutoff,
                                           const std::optional<PeriodicBox>& box = {}) {
-    const double range = validate(positions, radii, cutoff, box);
-    raw_.clear();
-    pairs_.clear();
-    pair_checks_ = 0;
-    n_ = {0, 0, 0};
-    if (positions.cols() < 2) return pairs_;
-    build(positions, radii, range, box);
-    if (box) collect<true>(cutoff, box->lengths);
-    else collect<false>(cutoff, Vec3::Zero());
-    sort_pairs(positions.cols());
-    return pairs_;
+    return query(positions, radii, cutoff, box, nullptr);
+  }
+
+  // The candidate pairs of find_pairs that have a marked body (marked[i] != 0, one entry per
+  // body), sorted as find_pairs sorts them: the same pairs, bit for bit the same test, from the
+  // marked bodies' neighbourhoods only. O(N) to sort the bodies into buckets, then O(marked).
+  const std::vector<BodyPair>& find_pairs_of(const Mat3X& positions, const VecX& radii, double cutoff,
+                                             const std::optional<PeriodicBox>& box, std::span<const char> marked) {
+    if (static_cast<Eigen::Index>(marked.size()) != positions.cols())
+      fail_argument("marked", "has " + std::to_string(marked.size()) + " entries for " +
+                                  std::to_string(positions.cols()) + " bodies");
+    return query(positions, radii, cutoff, box, &marked);
   }
 
   // Equal bodies of bounding radius `radius`.
@@ -96,6 +98,28 @@ class CellList {
   const std::array<std::int64_t, 3>& buckets_per_side() const { return n_; }
 
  private:
+  // find_pairs (marked: none) or find_pairs_of.
+  const std::vector<BodyPair>& query(const Mat3X& positions, const VecX& radii, double cutoff,
+                                     const std::optional<PeriodicBox>& box, const std::span<const char>* marked) {
+    const double range = validate(positions, radii, cutoff, box);
+    raw_.clear();
+    pairs_.clear();
+    pair_checks_ = 0;
+    n_ = {0, 0, 0};
+    if (positions.cols() < 2) return pairs_;
+    build(positions, radii, range, box);
+    const Vec3 length = box ? box->lengths : Vec3::Zero();
+    if (marked) {
+      if (box) collect_marked<true>(cutoff, length, *marked);
+      else collect_marked<false>(cutoff, length, *marked);
+    } else {
+      if (box) collect<true>(cutoff, length);
+      else collect<false>(cutoff, length);
+    }
+    sort_pairs(positions.cols());
+    return pairs_;
+  }
+
   static double validate(const Mat3X& x, const VecX& radii, double cutoff,
                          const std::optional<PeriodicBox>& box) {
     for (Eigen::Index i = 0; i < x.cols(); ++i)  // name the body, not the whole matrix
@@ -219,11 +243,13 @@ class CellList {
     }
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
     id_.resize(static_cast<std::size_t>(count));
+    slot_.resize(static_cast<std::size_t>(count));
     pos_.resize(3, count);
     rad_.resize(count);
     for (Eigen::Index i = 0; i < count; ++i) {
       const Eigen::Index slot = start_[static_cast<std::size_t>(bucket_[static_cast<std::size_t>(i)])]++;
       id_[static_cast<std::size_t>(slot)] = i;
+      slot_[static_cast<std::size_t>(i)] = slot;
       pos_.col(slot) = p.col(i);
       rad_[slot] = radii[i];
     }
@@ -288,6 +314,39 @@ class CellList {
     }
   }
 
+  // find_pairs_of's search: each marked body against every body of the (up to 27) buckets
+  // around its own, a pair of two marked bodies from the lower index only. within_reach is
+  // symmetric bit for bit (d and -d square alike, the minimum image flips with the sign), so
+  // a pair passes here exactly when collect passes it.
+  template <bool Periodic>
+  void collect_marked(double cutoff, const Vec3& length, std::span<const char> marked) {
+    const std::int64_t sx = n_[0], sy = n_[1];
+    std::int64_t nx[3], ny[3], nz[3];
+    for (std::size_t i = 0; i < marked.size(); ++i) {
+      if (!marked[i]) continue;
+      const std::int64_t b = bucket_[i];
+      const int mx = neighbours(b % sx, sx, nx), my = neighbours((b / sx) % sy, sy, ny), mz = neighbours(b / (sx * sy), n_[2], nz);
+      const Eigen::Index a = slot_[i];
+      for (int z = 0; z < mz; ++z)
+        for (int y = 0; y < my; ++y)
+          for (int x = 0; x < mx; ++x) {
+            const std::int64_t other = nx[x] + sx * (ny[y] + sy * nz[z]);
+            const Eigen::Index end = start_[static_cast<std::size_t>(other + 1)];
+            for (Eigen::Index c = start_[static_cast<std::size_t>(other)]; c < end; ++c) {
+              const Eigen::Index j = id_[static_cast<std::size_t>(c)];
+              if (j == static_cast<Eigen::Index>(i) || (marked[static_cast<std::size_t>(j)] && j < static_cast<Eigen::Index>(i)))
+                continue;
+              ++pair_checks_;
+              if (detail::within_reach<Periodic>(pos_.col(a).data(), pos_.col(c).data(), rad_[a], rad_[c], cutoff,
+                                                 length.data())) {
+                const auto body = static_cast<Eigen::Index>(i);
+                raw_.push_back(body < j ? BodyPair{body, j} : BodyPair{j, body});
+              }
+            }
+          }
+    }
+  }
+
   // Counting sort by i, then a (short) sort of each i's partners: O(pairs + N).
   void sort_pairs(Eigen::Index count) {
     first_.assign(static_cast<std::size_t>(count + 1), 0);
@@ -316,6 +375,7 @@ class CellList {
   Mat3X wrapped_, pos_;                       // pos_: positions in bucket order
   std::vector<std::int64_t> bucket_, start_;  // bucket of each body; first body of each bucket
   std::vector<Eigen::Index> id_, first_;      // body id in bucket order; pair runs by i
+  std::vector<Eigen::Index> slot_;            // each body's place in bucket order
 };
 
 // One-shot query; see CellList::find_pairs.

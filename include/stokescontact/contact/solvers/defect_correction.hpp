@@ -258,13 +258,6 @@ struct WorkingSetLcp {
   }
 };
 
-// The smallest distance of the flagged pairs at Q(lambda) = Q_t + dt Psi (U + M D lambda)
-// (Broms eq. 13), given M D lambda: no mobility application.
-template <Shape S, MobilityOperator M>
-double min_flagged_distance_at(const ContactStep<S, M>& step, const VecX& MD_lambda) {
-  return step.min_distance_at(MD_lambda);
-}
-
 // A ray of forces lambda(s) = base + s direction, s > 0, with M D of both (so every point
 // of it is free, M D linear in lambda). The whole iterate is the ray with base 0; a stalled
 // cluster's is its own forces scaled with the others' held (stalled_cluster_ray).
@@ -293,7 +286,7 @@ template <Shape S, MobilityOperator M>
 std::optional<double> ray_first_crossing(const ContactStep<S, M>& step, const ForceRay& ray, double s_max,
                                          double target, int samples, double tol) {
   VecX MD;  // one buffer for every sample: at 1e6 spheres a fresh one is 24 MB of new pages
-  const auto separated = [&](double s) { return min_flagged_distance_at(step, ray.MD(s, MD)) >= target; };
+  const auto separated = [&](double s) { return step.separated_at(ray.MD(s, MD), target); };
   double lo = 0.0, hi = -1.0;
   for (int j = 1; j <= samples; ++j) {
     const double s = s_max * j / samples;
@@ -496,7 +489,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       // (evaluating best_lambda again would overwrite e: its M D and distances were kept)
       const ForceRay ray = stalled_cluster_ray(step, best_lambda, best_MD, best_distances, target);
       for (double s_max = 2.0; s_max <= 1024.0; s_max *= 2.0)
-        if (min_flagged_distance_at(step, ray.MD(s_max)) >= target) {
+        if (step.separated_at(ray.MD(s_max), target)) {
           if (const std::optional<double> s =
                   ray_first_crossing(step, ray, s_max, target, 2 * options.ray_samples, ray_tol))
             return restart_from_crossing(step, ray, *s, out.iterations, options, subproblem,
