@@ -383,19 +383,25 @@ class ContactStep {
   // held at its overlap ends only (overlap_ends) gains its closest points: it ended too
   // close between them.
   std::size_t add_pairs(std::span<const ContactPair> found) {
-    std::set<std::pair<Eigen::Index, Eigen::Index>> known, ends_only;
+    using Key = std::pair<Eigen::Index, Eigen::Index>;
+    std::vector<Key> known, ends_only;  // sorted: Nc keys without a node each
+    known.reserve(pairs_.size());
     for (std::size_t k = 0; k < pairs_.size(); ++k)
-      if (!carried_[k]) (pairs_[k].segment_end ? ends_only : known).insert({pairs_[k].i, pairs_[k].j});
+      if (!carried_[k]) (pairs_[k].segment_end ? ends_only : known).push_back({pairs_[k].i, pairs_[k].j});
+    std::sort(known.begin(), known.end());
+    std::sort(ends_only.begin(), ends_only.end());
+    std::set<Key> added_keys;  // `found` may name a pair twice
     std::size_t added = 0;
     const std::size_t first = pairs_.size();
     std::vector<char> split;
-    for (const ContactPair& p : found)
-      if (known.insert({p.i, p.j}).second) {
-        pairs_.push_back(detail::contact_pair(problem_.shapes, std::span<const Pose>(trial_), p.i, p.j, problem_.box));
-        carried_.emplace_back();
-        split.push_back(!ends_only.contains({p.i, p.j}));
-        ++added;
-      }
+    for (const ContactPair& p : found) {
+      const Key key{p.i, p.j};
+      if (std::binary_search(known.begin(), known.end(), key) || !added_keys.insert(key).second) continue;
+      pairs_.push_back(detail::contact_pair(problem_.shapes, std::span<const Pose>(trial_), p.i, p.j, problem_.box));
+      carried_.emplace_back();
+      split.push_back(!std::binary_search(ends_only.begin(), ends_only.end(), key));
+      ++added;
+    }
     split_overlap_ends_from(first, split);
     if (added > 0) rebuild();
     return added;

@@ -212,12 +212,11 @@ class CellList {
       } else if (single_cell_) {
         cells_[k] = 1;
       } else {  // occupied span; +4 as (K, f) order may miss c by 1 at each end and an
-                // unfolded side must keep empty buckets between its ends
-        auto lo = open_cell(p(k, 0)), hi = lo;
-        for (Eigen::Index i = 1; i < count; ++i) {
-          const auto c = open_cell(p(k, i));
-          lo = std::min(lo, c), hi = std::max(hi, c);
-        }
+                // unfolded side must keep empty buckets between its ends. (K, f) is
+                // non-decreasing in x (lexicographically: K = floor(x / H), and within one K
+                // f = floor((x - K H) M / H), each step a rounded monotone map), so the span's
+                // ends are the cells of the least and the greatest coordinate.
+        const auto lo = open_cell(p.row(k).minCoeff()), hi = open_cell(p.row(k).maxCoeff());
         const double span = static_cast<double>(hi.first - lo.first) * static_cast<double>(fine_) +
                             static_cast<double>(hi.second - lo.second) + 1.0;
         cells_[k] = static_cast<std::int64_t>(std::min(span + 4.0, 0x1p62));
