@@ -31,6 +31,30 @@ TEST(ParallelFor, EveryIndexOnceWithTheSerialLoopsValues) {
   }
 }
 
+// A loop of a few large items (chunks of a longer loop) with its own threshold: each chunk
+// once, the same values, from two chunks on.
+TEST(ParallelFor, FewChunksWithTheirOwnThreshold) {
+  for (const std::ptrdiff_t chunks : {std::ptrdiff_t{0}, std::ptrdiff_t{1}, std::ptrdiff_t{2}, std::ptrdiff_t{64}}) {
+    std::vector<int> visits(static_cast<std::size_t>(chunks), 0);
+    std::vector<double> sums(static_cast<std::size_t>(chunks), 0.0), serial(static_cast<std::size_t>(chunks), 0.0);
+    const auto chunk_sum = [](std::ptrdiff_t c) {
+      double sum = 0.0;
+      for (int k = 0; k < 1000; ++k) sum += std::sqrt(static_cast<double>(1000 * c + k));
+      return sum;
+    };
+    sc::parallel_for(
+        chunks,
+        [&](std::ptrdiff_t c) {
+          ++visits[static_cast<std::size_t>(c)];
+          sums[static_cast<std::size_t>(c)] = chunk_sum(c);
+        },
+        2);
+    for (std::ptrdiff_t c = 0; c < chunks; ++c) serial[static_cast<std::size_t>(c)] = chunk_sum(c);
+    EXPECT_EQ(visits, std::vector<int>(static_cast<std::size_t>(chunks), 1)) << "chunks " << chunks;
+    EXPECT_EQ(sums, serial) << "chunks " << chunks;
+  }
+}
+
 // An exception leaves the loop on the calling thread: the one of the lowest index that threw,
 // whichever thread ran it (a validation error names its pair; it must name the first).
 TEST(ParallelFor, RethrowsTheExceptionOfTheLowestIndex) {

@@ -1,5 +1,6 @@
 // Cell-list broad phase: exactly the pairs of an O(N^2) brute force over the same predicate.
 #include "stokescontact/geometry/broad_phase.hpp"
+#include "stokescontact/core/parallel_for.hpp"
 
 #include <gtest/gtest.h>
 
@@ -82,6 +83,18 @@ TEST(BroadPhase, MatchesBruteForceUniformOpen) {
     expect_matches_brute_force(reused, x, VecX::Constant(n, radius), cutoff);
     EXPECT_EQ(reused.find_pairs(x, radius, cutoff), brute_force(x, VecX::Constant(n, radius), cutoff, {}));
   }
+}
+
+// Enough bodies for the queries to run in chunks on threads (kParallelForMinCount): the
+// same sorted pairs as brute force, open and periodic.
+TEST(BroadPhase, MatchesBruteForceInChunks) {
+  CellList reused;
+  std::mt19937_64 rng(77);
+  const Eigen::Index n = 3 * kParallelForMinCount;
+  const double side = cube_side(n, 0.5, 0.3);
+  const Mat3X x = uniform_in(rng, n, Vec3::Zero(), Vec3::Constant(side));
+  expect_matches_brute_force(reused, x, VecX::Constant(n, 0.5), 0.1);
+  expect_matches_brute_force(reused, x, VecX::Constant(n, 0.5), 0.1, PeriodicBox{Vec3::Constant(side)});
 }
 
 TEST(BroadPhase, MatchesBruteForceClustered) {

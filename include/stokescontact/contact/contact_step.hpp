@@ -366,7 +366,7 @@ class ContactStep {
       cost_ = pairs_.size() <= options.automatic_formed_max_pairs ? MobilityCost::formed : MobilityCost::matrix_free;
     carried_.assign(pairs_.size(), std::nullopt);
     if (options.whole_step)
-      for (std::size_t k = 0; k < pairs_.size(); ++k) carry_if_passing(k);
+      parallel_for(nc(), [&](std::ptrdiff_t k) { carry_if_passing(static_cast<std::size_t>(k)); });  // pair k only
     split_overlap_ends_from(0);
     rebuild();
     // Everything checked: only now touch the mobility.

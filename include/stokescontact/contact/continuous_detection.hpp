@@ -32,6 +32,7 @@
 
 #include "stokescontact/contact/contact_pairs.hpp"
 #include "stokescontact/contact/d_try.hpp"
+#include "stokescontact/core/parallel_for.hpp"
 #include "stokescontact/geometry/swept_distance.hpp"
 
 namespace stokescontact {
@@ -148,19 +149,30 @@ RelativePairs find_pairs_relative(std::span<const S> shapes, std::span<const Pos
   }
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
-  RelativePairs out;
-  for (const BodyPair& c : detail::swept_candidates(b.centres, b.radii, b.body_radius, multiplier * d_hat, box, list)) {
+  // Each candidate in its own slot (parallel_for), kept in candidate order.
+  const std::vector<BodyPair> candidates =
+      detail::swept_candidates(b.centres, b.radii, b.body_radius, multiplier * d_hat, box, list);
+  std::vector<std::optional<ContactPair>> flagged(candidates.size());
+  std::vector<double> thresholds(candidates.size());
+  parallel_for(static_cast<std::ptrdiff_t>(candidates.size()), [&](std::ptrdiff_t k) {
+    const BodyPair& c = candidates[static_cast<std::size_t>(k)];
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const S& si = shape_of(shapes, i);
     const S& sj = shape_of(shapes, j);
     const double d_try = multiplier * (d_hat + dt * distance_rate_bound(si, v[i], sj, v[j]));
-    if (!is_candidate_pair(trial[i].x, trial[j].x, bounding_radius(si), bounding_radius(sj), d_try, box)) continue;
+    if (!is_candidate_pair(trial[i].x, trial[j].x, bounding_radius(si), bounding_radius(sj), d_try, box)) return;
     ContactPair pair = detail::contact_pair(shapes, trial, c.i, c.j, box);
     if (pair.points.distance <= d_try) {
-      out.pairs.push_back(pair);
-      out.d_try.push_back(d_try);
+      flagged[static_cast<std::size_t>(k)] = std::move(pair);
+      thresholds[static_cast<std::size_t>(k)] = d_try;
     }
-  }
+  });
+  RelativePairs out;
+  for (std::size_t k = 0; k < candidates.size(); ++k)
+    if (flagged[k]) {
+      out.pairs.push_back(std::move(*flagged[k]));
+      out.d_try.push_back(thresholds[k]);
+    }
   return out;
 }
 
@@ -209,29 +221,35 @@ std::vector<TrajectoryCrossing> trajectory_crossings(std::span<const S> shapes, 
   if (scope && static_cast<std::size_t>(scope->moved.size()) != poses.size())
     fail_argument("CrossingScope.moved", "has " + std::to_string(scope->moved.size()) + " entries for " +
                                              std::to_string(poses.size()) + " bodies");
+  const std::span<const char> moved = scope ? scope->moved : std::span<const char>{};
   std::vector<BodyPair> candidates =
-      detail::swept_candidates(b.centres, b.radii, b.body_radius, cutoff, box, list, scope ? scope->moved : std::span<const char>{});
+      detail::swept_candidates(b.centres, b.radii, b.body_radius, cutoff, box, list, moved);
   if (scope) {  // the listed pairs of two unmoved bodies, through the broad phase's own test
-    const auto moved = [&](Eigen::Index k) { return scope->moved[static_cast<std::size_t>(k)] != 0; };
+    const auto moves = [&](Eigen::Index k) { return moved[static_cast<std::size_t>(k)] != 0; };
     for (const BodyPair& p : scope->pairs) {
       const auto n = static_cast<Eigen::Index>(poses.size());
       if (!(0 <= p.i && p.i < n && 0 <= p.j && p.j < n && p.i != p.j))
         fail_argument("CrossingScope.pairs", "(" + std::to_string(p.i) + ", " + std::to_string(p.j) +
                                                  ") must be distinct indices into poses, N = " + std::to_string(n));
-      if (!moved(p.i) && !moved(p.j) &&
+      if (!moves(p.i) && !moves(p.j) &&
           is_candidate_pair(b.centres.col(p.i), b.centres.col(p.j), b.radii[p.i], b.radii[p.j], cutoff, box))
         candidates.push_back(p.i < p.j ? p : BodyPair{p.j, p.i});
     }
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
   }
-  for (const BodyPair& c : candidates) {
+  // Each candidate in its own slot (parallel_for), kept in candidate order.
+  std::vector<std::optional<TrajectoryCrossing>> found(candidates.size());
+  parallel_for(static_cast<std::ptrdiff_t>(candidates.size()), [&](std::ptrdiff_t k) {
+    const BodyPair& c = candidates[static_cast<std::size_t>(k)];
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const Vec3 shift = minimum_image_shift(b.centres.col(c.i), b.centres.col(c.j), box);
     SweptDistance first = first_time_below(shape_of(shapes, i), poses[i], v[i], shape_of(shapes, j),
                                            shifted(poses[j], shift), v[j], dt, threshold, tolerance);
-    if (first.below) out.push_back({c.i, c.j, shift, std::move(first)});
-  }
+    if (first.below) found[static_cast<std::size_t>(k)] = TrajectoryCrossing{c.i, c.j, shift, std::move(first)};
+  });
+  for (std::optional<TrajectoryCrossing>& f : found)
+    if (f) out.push_back(std::move(*f));
   return out;
 }
 

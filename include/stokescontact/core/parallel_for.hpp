@@ -4,7 +4,7 @@
 // loop, bit for bit: no reduction is reordered, every index runs the same code. An exception
 // thrown by the body (a validation error naming a pair) leaves the loop and is rethrown on
 // the calling thread after it, the first one by index; without OpenMP, or below
-// kParallelForMinCount indices, the loop runs serially.
+// kParallelForMinCount indices (or the caller's min_count), the loop runs serially.
 #include <cstddef>
 #include <exception>
 #include <vector>
@@ -15,10 +15,12 @@ namespace stokescontact {
 // per parallel region against about 0.1-1 us per pair distance).
 inline constexpr std::ptrdiff_t kParallelForMinCount = 2048;
 
+// `min_count`: the fewest indices worth the threads; a loop of a few large items (chunks of
+// a longer loop) passes a smaller one.
 template <class Body>
-void parallel_for(std::ptrdiff_t count, Body&& body) {
+void parallel_for(std::ptrdiff_t count, Body&& body, std::ptrdiff_t min_count = kParallelForMinCount) {
 #ifdef _OPENMP
-  if (count >= kParallelForMinCount) {
+  if (count >= min_count && count > 1) {
     std::exception_ptr first;
     std::ptrdiff_t first_index = count;
 #pragma omp parallel for schedule(static)

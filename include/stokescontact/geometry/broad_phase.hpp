@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "stokescontact/core/errors.hpp"
+#include "stokescontact/core/parallel_for.hpp"
 #include "stokescontact/core/types.hpp"
 #include "stokescontact/geometry/periodic_box.hpp"
 
@@ -102,7 +103,8 @@ class CellList {
   const std::vector<BodyPair>& query(const Mat3X& positions, const VecX& radii, double cutoff,
                                      const std::optional<PeriodicBox>& box, const std::span<const char>* marked) {
     const double range = validate(positions, radii, cutoff, box);
-    raw_.clear();
+    found_.resize(1);
+    found_[0].clear();
     pairs_.clear();
     pair_checks_ = 0;
     n_ = {0, 0, 0};
@@ -235,11 +237,11 @@ class CellList {
     const std::int64_t buckets = n_[0] * n_[1] * n_[2];
     bucket_.resize(static_cast<std::size_t>(count));
     start_.assign(static_cast<std::size_t>(buckets + 1), 0);
-    for (Eigen::Index i = 0; i < count; ++i) {
-      const std::int64_t b = side_bucket(0, p(0, i)) + n_[0] * (side_bucket(1, p(1, i)) + n_[1] * side_bucket(2, p(2, i)));
-      bucket_[static_cast<std::size_t>(i)] = b;
-      ++start_[static_cast<std::size_t>(b + 1)];
-    }
+    parallel_for(count, [&](std::ptrdiff_t i) {
+      bucket_[static_cast<std::size_t>(i)] =
+          side_bucket(0, p(0, i)) + n_[0] * (side_bucket(1, p(1, i)) + n_[1] * side_bucket(2, p(2, i)));
+    });
+    for (const std::int64_t b : bucket_) ++start_[static_cast<std::size_t>(b + 1)];
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
     id_.resize(static_cast<std::size_t>(count));
     slot_.resize(static_cast<std::size_t>(count));
@@ -265,30 +267,51 @@ class CellList {
     return m;
   }
 
+  // `part(first, last, found, checks)` over the items [0, count) in chunks, each chunk's pairs
+  // in its own buffer of found_ (their order does not matter: sort_pairs sorts them all) and
+  // its checks added up after; the chunks run on OpenMP threads (parallel_for) from
+  // kParallelForMinCount bodies on, so the pairs and their order are those of one thread.
+  template <class Part>
+  void collect_in_chunks(std::int64_t count, Part&& part) {
+    const std::int64_t chunks = pos_.cols() >= kParallelForMinCount ? std::clamp<std::int64_t>(count, 1, 64) : 1;
+    found_.resize(static_cast<std::size_t>(chunks));
+    chunk_checks_.assign(static_cast<std::size_t>(chunks), 0);
+    parallel_for(
+        chunks,
+        [&](std::ptrdiff_t c) {
+          std::vector<BodyPair>& found = found_[static_cast<std::size_t>(c)];
+          found.clear();
+          part(count * c / chunks, count * (c + 1) / chunks, found, chunk_checks_[static_cast<std::size_t>(c)]);
+        },
+        2);
+    for (const std::int64_t checks : chunk_checks_) pair_checks_ += checks;
+  }
+
   // Each unordered pair of neighbouring buckets once, from the lower index (rows of x-adjacent
   // buckets compared first), so each body pair is tested once even on sides of 1 or 2 buckets.
   // Bodies are in bucket order, x fastest: an inner run bx-1..bx+1 of a row is one range.
+  // Rows (by, bz) in chunks (collect_in_chunks).
   template <bool Periodic>
   void collect(double cutoff, const Vec3& length) {
-    raw_.reserve(std::max(raw_.capacity(), 2 * static_cast<std::size_t>(pos_.cols())));
-    auto cross = [&](Eigen::Index begin, Eigen::Index end, Eigen::Index other, Eigen::Index other_end) {
-      pair_checks_ += (end - begin) * (other_end - other);
-      for (Eigen::Index a = begin; a < end; ++a)
-        for (Eigen::Index c = std::max(other, a + 1); c < other_end; ++c)
-          if (detail::within_reach<Periodic>(pos_.col(a).data(), pos_.col(c).data(), rad_[a], rad_[c],
-                                             cutoff, length.data())) {
-            const Eigen::Index i = id_[static_cast<std::size_t>(a)], j = id_[static_cast<std::size_t>(c)];
-            raw_.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
-          }
-    };
-    auto at = [&](std::int64_t bucket) { return start_[static_cast<std::size_t>(bucket)]; };
-    const std::int64_t sx = n_[0];
-    std::int64_t nx[3], ny[3], nz[3];
-    for (std::int64_t bz = 0; bz < n_[2]; ++bz) {
-      const int mz = neighbours(bz, n_[2], nz);
-      for (std::int64_t by = 0; by < n_[1]; ++by) {
+    collect_in_chunks(n_[1] * n_[2], [&](std::int64_t first_row, std::int64_t last_row, std::vector<BodyPair>& found,
+                                         std::int64_t& checks) {
+      auto cross = [&](Eigen::Index begin, Eigen::Index end, Eigen::Index other, Eigen::Index other_end) {
+        checks += (end - begin) * (other_end - other);
+        for (Eigen::Index a = begin; a < end; ++a)
+          for (Eigen::Index c = std::max(other, a + 1); c < other_end; ++c)
+            if (detail::within_reach<Periodic>(pos_.col(a).data(), pos_.col(c).data(), rad_[a], rad_[c], cutoff,
+                                               length.data())) {
+              const Eigen::Index i = id_[static_cast<std::size_t>(a)], j = id_[static_cast<std::size_t>(c)];
+              found.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
+            }
+      };
+      auto at = [&](std::int64_t bucket) { return start_[static_cast<std::size_t>(bucket)]; };
+      const std::int64_t sx = n_[0];
+      std::int64_t nx[3], ny[3], nz[3];
+      for (std::int64_t row = first_row; row < last_row; ++row) {
+        const std::int64_t by = row % n_[1], bz = row / n_[1];
+        const int mz = neighbours(bz, n_[2], nz);
         const int my = neighbours(by, n_[1], ny);
-        const std::int64_t row = by + n_[1] * bz;
         for (std::int64_t bx = 0; bx < sx; ++bx) {
           const std::int64_t b = bx + sx * row;
           const Eigen::Index begin = at(b), end = at(b + 1);
@@ -296,7 +319,7 @@ class CellList {
           const int mx = neighbours(bx, sx, nx);
           const bool inner = bx >= 1 && bx + 1 < sx;
           cross(begin, end, begin, end);  // within the bucket: c > a
-          pair_checks_ -= (end - begin) * (end - begin + 1) / 2;  // counted pairs c > a only
+          checks -= (end - begin) * (end - begin + 1) / 2;  // counted pairs c > a only
           for (int z = 0; z < mz; ++z)
             for (int y = 0; y < my; ++y) {
               const std::int64_t other = ny[y] + n_[1] * nz[z];
@@ -310,49 +333,57 @@ class CellList {
             }
         }
       }
-    }
+    });
   }
 
   // find_pairs_of's search: each marked body against every body of the (up to 27) buckets
   // around its own, a pair of two marked bodies from the lower index only. within_reach is
   // symmetric bit for bit (d and -d square alike, the minimum image flips with the sign), so
-  // a pair passes here exactly when collect passes it.
+  // a pair passes here exactly when collect passes it. Bodies in chunks (collect_in_chunks).
   template <bool Periodic>
   void collect_marked(double cutoff, const Vec3& length, std::span<const char> marked) {
-    const std::int64_t sx = n_[0], sy = n_[1];
-    std::int64_t nx[3], ny[3], nz[3];
-    for (std::size_t i = 0; i < marked.size(); ++i) {
-      if (!marked[i]) continue;
-      const std::int64_t b = bucket_[i];
-      const int mx = neighbours(b % sx, sx, nx), my = neighbours((b / sx) % sy, sy, ny), mz = neighbours(b / (sx * sy), n_[2], nz);
-      const Eigen::Index a = slot_[i];
-      for (int z = 0; z < mz; ++z)
-        for (int y = 0; y < my; ++y)
-          for (int x = 0; x < mx; ++x) {
-            const std::int64_t other = nx[x] + sx * (ny[y] + sy * nz[z]);
-            const Eigen::Index end = start_[static_cast<std::size_t>(other + 1)];
-            for (Eigen::Index c = start_[static_cast<std::size_t>(other)]; c < end; ++c) {
-              const Eigen::Index j = id_[static_cast<std::size_t>(c)];
-              if (j == static_cast<Eigen::Index>(i) || (marked[static_cast<std::size_t>(j)] && j < static_cast<Eigen::Index>(i)))
-                continue;
-              ++pair_checks_;
-              if (detail::within_reach<Periodic>(pos_.col(a).data(), pos_.col(c).data(), rad_[a], rad_[c], cutoff,
-                                                 length.data())) {
-                const auto body = static_cast<Eigen::Index>(i);
-                raw_.push_back(body < j ? BodyPair{body, j} : BodyPair{j, body});
+    const auto is_marked = [&](Eigen::Index k) { return marked[static_cast<std::size_t>(k)] != 0; };
+    const auto part = [&](std::int64_t first, std::int64_t last, std::vector<BodyPair>& found, std::int64_t& checks) {
+      const std::int64_t sx = n_[0], sy = n_[1];
+      std::int64_t nx[3], ny[3], nz[3];
+      for (Eigen::Index i = first; i < last; ++i) {
+        if (!is_marked(i)) continue;
+        const std::int64_t b = bucket_[static_cast<std::size_t>(i)];
+        const int mx = neighbours(b % sx, sx, nx);
+        const int my = neighbours((b / sx) % sy, sy, ny);
+        const int mz = neighbours(b / (sx * sy), n_[2], nz);
+        const Eigen::Index a = slot_[static_cast<std::size_t>(i)];
+        for (int z = 0; z < mz; ++z)
+          for (int y = 0; y < my; ++y)
+            for (int x = 0; x < mx; ++x) {
+              const std::int64_t other = nx[x] + sx * (ny[y] + sy * nz[z]);
+              const Eigen::Index end = start_[static_cast<std::size_t>(other + 1)];
+              for (Eigen::Index c = start_[static_cast<std::size_t>(other)]; c < end; ++c) {
+                const Eigen::Index j = id_[static_cast<std::size_t>(c)];
+                if (j == i || (is_marked(j) && j < i)) continue;
+                ++checks;
+                if (detail::within_reach<Periodic>(pos_.col(a).data(), pos_.col(c).data(), rad_[a], rad_[c], cutoff,
+                                                   length.data()))
+                  found.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
               }
             }
-          }
-    }
+      }
+    };
+    collect_in_chunks(static_cast<std::int64_t>(marked.size()), part);
   }
 
   // Counting sort by i, then a (short) sort of each i's partners: O(pairs + N).
   void sort_pairs(Eigen::Index count) {
     first_.assign(static_cast<std::size_t>(count + 1), 0);
-    for (const BodyPair& q : raw_) ++first_[static_cast<std::size_t>(q.i + 1)];
+    std::size_t total = 0;
+    for (const std::vector<BodyPair>& found : found_) {
+      total += found.size();
+      for (const BodyPair& q : found) ++first_[static_cast<std::size_t>(q.i + 1)];
+    }
     std::partial_sum(first_.begin(), first_.end(), first_.begin());
-    pairs_.resize(raw_.size());
-    for (const BodyPair& q : raw_) pairs_[static_cast<std::size_t>(first_[static_cast<std::size_t>(q.i)]++)] = q;
+    pairs_.resize(total);
+    for (const std::vector<BodyPair>& found : found_)
+      for (const BodyPair& q : found) pairs_[static_cast<std::size_t>(first_[static_cast<std::size_t>(q.i)]++)] = q;
     auto begin = pairs_.begin();  // first_[i] is now the end of i's run
     for (Eigen::Index i = 0; i < count; ++i) {
       const auto end = pairs_.begin() + first_[static_cast<std::size_t>(i)];
@@ -361,7 +392,9 @@ class CellList {
     }
   }
 
-  std::vector<BodyPair> raw_, pairs_;  // found in bucket order; sorted
+  std::vector<std::vector<BodyPair>> found_;  // per chunk of a query, in bucket order
+  std::vector<BodyPair> pairs_;               // sorted
+  std::vector<std::int64_t> chunk_checks_;
   std::int64_t pair_checks_ = 0;
   std::array<std::int64_t, 3> n_{}, cells_{};  // buckets and (unfolded) cells per side
   std::array<double, 3> scale_{};              // periodic: cells per unit length
