@@ -32,7 +32,6 @@
 
 #include "stokescontact/contact/contact_pairs.hpp"
 #include "stokescontact/contact/d_try.hpp"
-#include "stokescontact/core/parallel_for.hpp"
 #include "stokescontact/geometry/swept_distance.hpp"
 
 namespace stokescontact {
@@ -149,30 +148,26 @@ RelativePairs find_pairs_relative(std::span<const S> shapes, std::span<const Pos
   }
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
-  // Each candidate in its own slot (parallel_for), kept in candidate order.
-  const std::vector<BodyPair> candidates =
-      detail::swept_candidates(b.centres, b.radii, b.body_radius, multiplier * d_hat, box, list);
-  std::vector<std::optional<ContactPair>> flagged(candidates.size());
-  std::vector<double> thresholds(candidates.size());
-  parallel_for(static_cast<std::ptrdiff_t>(candidates.size()), [&](std::ptrdiff_t k) {
-    const BodyPair& c = candidates[static_cast<std::size_t>(k)];
+  // A candidate's threshold, and its measurement where it may be flagged.
+  const auto measure = [&](const BodyPair& c) -> std::pair<std::optional<ContactPair>, double> {
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const S& si = shape_of(shapes, i);
     const S& sj = shape_of(shapes, j);
     const double d_try = multiplier * (d_hat + dt * distance_rate_bound(si, v[i], sj, v[j]));
-    if (!is_candidate_pair(trial[i].x, trial[j].x, bounding_radius(si), bounding_radius(sj), d_try, box)) return;
-    ContactPair pair = detail::contact_pair(shapes, trial, c.i, c.j, box);
-    if (pair.points.distance <= d_try) {
-      flagged[static_cast<std::size_t>(k)] = std::move(pair);
-      thresholds[static_cast<std::size_t>(k)] = d_try;
-    }
-  });
+    if (!is_candidate_pair(trial[i].x, trial[j].x, bounding_radius(si), bounding_radius(sj), d_try, box))
+      return {std::nullopt, d_try};
+    return {detail::contact_pair(shapes, trial, c.i, c.j, box), d_try};
+  };
   RelativePairs out;
-  for (std::size_t k = 0; k < candidates.size(); ++k)
-    if (flagged[k]) {
-      out.pairs.push_back(std::move(*flagged[k]));
-      out.d_try.push_back(thresholds[k]);
-    }
+  detail::measure_candidates(
+      detail::swept_candidates(b.centres, b.radii, b.body_radius, multiplier * d_hat, box, list), measure,
+      [&](const BodyPair&, std::pair<std::optional<ContactPair>, double>& measured) {
+        auto& [pair, d_try] = measured;
+        if (pair && pair->points.distance <= d_try) {
+          out.pairs.push_back(std::move(*pair));
+          out.d_try.push_back(d_try);
+        }
+      });
   return out;
 }
 
@@ -238,18 +233,18 @@ std::vector<TrajectoryCrossing> trajectory_crossings(std::span<const S> shapes, 
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
   }
-  // Each candidate in its own slot (parallel_for), kept in candidate order.
-  std::vector<std::optional<TrajectoryCrossing>> found(candidates.size());
-  parallel_for(static_cast<std::ptrdiff_t>(candidates.size()), [&](std::ptrdiff_t k) {
-    const BodyPair& c = candidates[static_cast<std::size_t>(k)];
+  const auto advance_to_threshold = [&](const BodyPair& c) -> std::optional<TrajectoryCrossing> {
     const auto i = static_cast<std::size_t>(c.i), j = static_cast<std::size_t>(c.j);
     const Vec3 shift = minimum_image_shift(b.centres.col(c.i), b.centres.col(c.j), box);
     SweptDistance first = first_time_below(shape_of(shapes, i), poses[i], v[i], shape_of(shapes, j),
                                            shifted(poses[j], shift), v[j], dt, threshold, tolerance);
-    if (first.below) found[static_cast<std::size_t>(k)] = TrajectoryCrossing{c.i, c.j, shift, std::move(first)};
-  });
-  for (std::optional<TrajectoryCrossing>& f : found)
-    if (f) out.push_back(std::move(*f));
+    if (!first.below) return std::nullopt;
+    return TrajectoryCrossing{c.i, c.j, shift, std::move(first)};
+  };
+  detail::measure_candidates(candidates, advance_to_threshold,
+                             [&](const BodyPair&, std::optional<TrajectoryCrossing>& c) {
+                               if (c) out.push_back(std::move(*c));
+                             });
   return out;
 }
 
