@@ -103,8 +103,7 @@ class CellList {
   const std::vector<BodyPair>& query(const Mat3X& positions, const VecX& radii, double cutoff,
                                      const std::optional<PeriodicBox>& box, const std::span<const char>* marked) {
     const double range = validate(positions, radii, cutoff, box);
-    found_.resize(1);
-    found_[0].clear();
+    for (std::vector<BodyPair>& found : found_) found.clear();  // kept with their capacity
     pairs_.clear();
     pair_checks_ = 0;
     n_ = {0, 0, 0};
@@ -274,7 +273,7 @@ class CellList {
   template <class Part>
   void collect_in_chunks(std::int64_t count, Part&& part) {
     const std::int64_t chunks = pos_.cols() >= kParallelForMinCount ? std::clamp<std::int64_t>(count, 1, 64) : 1;
-    found_.resize(static_cast<std::size_t>(chunks));
+    if (found_.size() < static_cast<std::size_t>(chunks)) found_.resize(static_cast<std::size_t>(chunks));
     chunk_checks_.assign(static_cast<std::size_t>(chunks), 0);
     parallel_for(
         chunks,
@@ -392,7 +391,9 @@ class CellList {
     }
   }
 
-  std::vector<std::vector<BodyPair>> found_;  // per chunk of a query, in bucket order
+  // Per chunk of a query, in bucket order; buffers beyond the query's chunks stay empty, and
+  // all keep their capacity across queries.
+  std::vector<std::vector<BodyPair>> found_;
   std::vector<BodyPair> pairs_;               // sorted
   std::vector<std::int64_t> chunk_checks_;
   std::int64_t pair_checks_ = 0;
