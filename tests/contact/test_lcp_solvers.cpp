@@ -366,6 +366,29 @@ TEST_P(LcpSolverTest, InfeasibleProblemIsReportedUnconverged) {
   EXPECT_GE(null_start.residual, 1.0 - 1e-12);
 }
 
+// The same kind of problem for minimum-map Newton's stall window: A = [1 -1; -1 1] with
+// b = (-1, -2) has no solution (w_1 + w_2 = -3), c = 1/5 > 0 so Newton runs, and its merit
+// stops falling. Without the window it takes every one of its 1000 steps; with the default
+// window of 50 it stops within the window (plus the step it decides on) at the same residual
+// to 1e-9 (0.75).
+TEST(LcpSolvers, NewtonStopsWhenItsMeritStopsFalling) {
+  sc::MatX A(2, 2);
+  A << 1.0, -1.0, -1.0, 1.0;
+  const sc::VecX b = (sc::VecX(2) << -1.0, -2.0).finished();
+  const sc::LcpOptions without{.stall_window = 0};
+  const sc::LcpResult crawled = sc::solve_lcp_minimum_map_newton(A, b, without);
+  EXPECT_FALSE(crawled.converged);
+  EXPECT_EQ(crawled.iterations, without.max_iterations);
+  const sc::LcpOptions with{};
+  ASSERT_EQ(with.stall_window, 50);
+  const sc::LcpResult stopped = sc::solve_lcp_minimum_map_newton(A, b, with);
+  EXPECT_FALSE(stopped.converged);
+  EXPECT_LE(stopped.iterations, with.stall_window + 2);
+  EXPECT_GE(stopped.iterations, with.stall_window);
+  EXPECT_NEAR(stopped.residual, crawled.residual, 1e-6);  // 0.75: the least |min(gamma, w)|_inf
+  EXPECT_LT(stopped.operator_applications, crawled.operator_applications / 10);
+}
+
 TEST_P(LcpSolverTest, EmptyAndZeroProblemsAreSolvedForFree) {
   const sc::LcpResult empty = solve(sc::MatX(0, 0), sc::VecX());
   EXPECT_TRUE(empty.converged);
@@ -411,6 +434,7 @@ TEST_P(LcpSolverTest, RejectsBadInputNamingTheField) {
   EXPECT_EQ(field_of(b, {.tolerance = -1e-8}, nullptr).rfind("LcpOptions.tolerance:", 0), 0u);
   EXPECT_EQ(field_of(b, {.max_iterations = 0}, nullptr).rfind("LcpOptions.max_iterations:", 0), 0u);
   EXPECT_EQ(field_of(b, {.max_iterations = -3}, nullptr).rfind("LcpOptions.max_iterations:", 0), 0u);
+  EXPECT_EQ(field_of(b, {.stall_window = -1}, nullptr).rfind("LcpOptions.stall_window:", 0), 0u);
   // A callable that returns the wrong size or non-finite values.
   const sc::VecX negative_b = -sc::VecX::Ones(3);
   const auto wrong_size = [](const sc::VecX&) { return sc::VecX::Zero(2).eval(); };

@@ -45,6 +45,12 @@ struct LcpOptions {
   int gmres_unpreconditioned_steps = 50;
   // Newton: Armijo halvings per line search; APGD: doublings of L per step.
   int max_line_search_steps = 40;
+  // Minimum-map Newton only: it gives up when its best merit has not halved over this many
+  // Newton steps (0: never). An LCP whose matrix is not a P-matrix (a secant-corrected
+  // working-set model is not symmetric) can have no solution, and Newton then crawls on to
+  // max_iterations (dense Brownian rods: 1000 steps of 40 GMRES products each, see
+  // minimum_map_newton.hpp).
+  int stall_window = 50;
 
   void validate() const {
     require_positive(tolerance, "LcpOptions.tolerance");
@@ -55,6 +61,7 @@ struct LcpOptions {
     at_least_one(gmres_restart, "LcpOptions.gmres_restart");
     at_least_one(gmres_max_iterations, "LcpOptions.gmres_max_iterations");
     at_least_one(max_line_search_steps, "LcpOptions.max_line_search_steps");
+    if (stall_window < 0) fail_argument("LcpOptions.stall_window", "must be >= 0, got " + std::to_string(stall_window));
     require_non_negative(regularization, "LcpOptions.regularization");
     if (gmres_unpreconditioned_steps < 0)
       fail_argument("LcpOptions.gmres_unpreconditioned_steps",

@@ -28,7 +28,12 @@
 // Line 8: Armijo backtracking on the merit psi = 1/2 |min(lambda, y / c)|^2 along lambda + tau d.
 // When d is not a descent direction for psi (GMRES too inexact, singular A_AA) or no step along
 // it is accepted, a steepest-descent step on psi, d = -J^T H, is taken instead; when that fails
-// too the solver stops and says so.
+// too the solver stops and says so. It stops as well when its least merit has not halved over
+// LcpOptions::stall_window Newton steps (50): a working-set model corrected by secants is not
+// symmetric, need not be a P-matrix, and its LCP can have no solution; Newton then crawled on to
+// max_iterations (1000 steps, each of ~40 GMRES products, on 600-760 pairs of dense Brownian
+// rods at eta 0.45), where every LCP that converged on those rods, on Fig. 4 and on the dense
+// contact networks had halved its merit within 50 steps but one (docs/results.md).
 //
 // Differences from Alg. 2, each measured on the tests' problems: the scale c (with c = 1 Newton
 // stalled where A is far from unit scale); the proximal term (without it 12 of 79 problems with
@@ -225,6 +230,13 @@ inline double armijo_step(MinimumMapState& s, const MinimumMapDirection& dir, do
   return 0.0;
 }
 
+// Whether the least merit has not halved over the last `window` Newton steps (best_psi[k]: the
+// least psi up to step k; window 0: never).
+inline bool stalled(const std::vector<double>& best_psi, int window) {
+  const auto w = static_cast<std::size_t>(window);
+  return window > 0 && best_psi.size() > w && best_psi.back() > 0.5 * best_psi[best_psi.size() - 1 - w];
+}
+
 }  // namespace detail
 
 // `preconditioner`, when given: a sparse symmetric matrix close to A (same size), whose
@@ -256,6 +268,7 @@ LcpResult solve_lcp_minimum_map_newton(ApplyA&& apply_A, const VecX& b, const Lc
   const double H0_norm = detail::scaled_minimum_map(s.lambda, s.y, c).norm();
   double eta_cap = options.forcing_max;
   detail::ActiveBlockPreconditioner block_preconditioner(preconditioner);
+  std::vector<double> best_psi;  // the least merit up to each Newton step, for the stall window
   int k = 0;
   for (;;) {
     if (solve.converged(s.lambda, s.y)) {
@@ -267,6 +280,8 @@ LcpResult solve_lcp_minimum_map_newton(ApplyA&& apply_A, const VecX& b, const Lc
     ++k;
     const VecX H = detail::scaled_minimum_map(s.lambda, s.y, c);
     const double psi = 0.5 * H.squaredNorm();
+    best_psi.push_back(best_psi.empty() ? psi : std::min(psi, best_psi.back()));
+    if (detail::stalled(best_psi, options.stall_window)) break;
     std::vector<Eigen::Index> active;  // Alg. 2 line 5: {i : y_i < c lambda_i}
     for (Eigen::Index i = 0; i < H.size(); ++i)
       if (s.y(i) < c * s.lambda(i)) active.push_back(i);
