@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """Z of Brownian spherocylinders against the step size, from brownian_rods' JSON lines
 (any number of files; runs of one seed at several --dt may come from several files), and its
-extrapolation to dt -> 0, seed by seed and for the seeds together:
+extrapolation to dt -> 0, run by run and for the runs together:
 
     /usr/bin/python3 scripts/rod_eos_fit.py [--plot FIGURE.png] RUNS.jsonl [RUNS.jsonl ...]
 
-Per seed (and for the mean over the seeds at each dt, error bars combined in quadrature):
-Z at each dt D_R, the weighted straight line Z = Z_0 + c sqrt(dt) (weights 1 / error^2, as
+Per run (a seed and its melt), and for the mean over the runs at each dt (error bars combined
+in quadrature): Z at each dt D_R, the weighted straight line Z = Z_0 + c sqrt(dt) (weights 1 / error^2, as
 brownian_rods' own "dt -> 0" row, examples/common/brownian_pressure.hpp) with its chi^2 per
 degree of freedom, and with three or more step sizes the line through the smallest two and
 the parabola Z = Z_0 + c1 sqrt(dt) + c2 dt, each against McGrother et al.'s Monte Carlo Z
@@ -65,6 +65,13 @@ def fits(points):
     return out
 
 
+def against(z0, error, reference):
+    """Z_0 against the Monte Carlo Z, in percent and in error bars of Z_0."""
+    if not reference:
+        return ""
+    return f"{100 * (z0 / reference - 1):+.1f}% ({abs(z0 - reference) / error:.1f} error bars)"
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("runs", nargs="+")
@@ -72,38 +79,36 @@ def main():
     args = parser.parse_args()
     runs = load(args.runs)
     by_eta = {}
-    for (eta, seed), per_dt in sorted(runs.items()):
-        by_eta.setdefault(eta, {})[seed] = per_dt
+    for (eta, run), per_dt in sorted(runs.items()):
+        by_eta.setdefault(eta, {})[run] = per_dt
     panels = []
-    for eta, seeds in by_eta.items():
-        reference = next(iter(next(iter(seeds.values())).values())).get("mcgrother_Z")
+    for eta, runs_at in by_eta.items():
+        reference = next(iter(next(iter(runs_at.values())).values())).get("mcgrother_Z")
         print(f"eta {eta}" + (f", McGrother et al. Z = {reference:.4f}" if reference else ""))
         print("| run | dt D_R: Z +- error (S) | fit | Z_0 | chi^2 / dof | Z_0 against McGrother |")
         print("| --- | --- | --- | --- | --- | --- |")
         series = []
-        for seed, per_dt in seeds.items():
+        for run, per_dt in runs_at.items():
             points = [(dt, r["Z"], r["Z_error"]) for dt, r in per_dt.items()]
             label = ", ".join(f"{dt:g}: {r['Z']:.3f} +- {r['Z_error']:.3f}"
                               + (f" (S {r['nematic_order']:.2f})" if "nematic_order" in r else "")
                               for dt, r in sorted(per_dt.items()))
-            series.append((str(seed), points))
+            series.append((run, points))
             if len(points) < 2:
-                print(f"| {seed} | {label} | - | | | |")
+                print(f"| {run} | {label} | - | | | |")
             for name, z0, err, chi2 in fits(points):
-                against = f"{100 * (z0 / reference - 1):+.1f}% ({abs(z0 - reference) / err:.1f} error bars)" if reference else ""
-                print(f"| {seed} | {label} | {name} | {z0:.3f} +- {err:.3f} | {chi2:.2f} | {against} |")
-        common = sorted(set.intersection(*[set(p) for p in seeds.values()]))
-        if len(seeds) > 1 and len(common) >= 2:
+                print(f"| {run} | {label} | {name} | {z0:.3f} +- {err:.3f} | {chi2:.2f} | {against(z0, err, reference)} |")
+        common = sorted(set.intersection(*[set(p) for p in runs_at.values()]))
+        if len(runs_at) > 1 and len(common) >= 2:
             points = []
             for dt in common:
-                zs = [seeds[s][dt]["Z"] for s in seeds]
-                es = [seeds[s][dt]["Z_error"] for s in seeds]
+                zs = [per_dt[dt]["Z"] for per_dt in runs_at.values()]
+                es = [per_dt[dt]["Z_error"] for per_dt in runs_at.values()]
                 points.append((dt, sum(zs) / len(zs), math.sqrt(sum(e * e for e in es)) / len(es)))
-            series.append(("mean of the seeds", points))
+            series.append(("mean of the runs", points))
             label = ", ".join(f"{dt:g}: {z:.3f} +- {e:.3f}" for dt, z, e in points)
             for name, z0, err, chi2 in fits(points):
-                against = f"{100 * (z0 / reference - 1):+.1f}% ({abs(z0 - reference) / err:.1f} error bars)" if reference else ""
-                print(f"| mean of {len(seeds)} | {label} | {name} | {z0:.3f} +- {err:.3f} | {chi2:.2f} | {against} |")
+                print(f"| mean of {len(runs_at)} | {label} | {name} | {z0:.3f} +- {err:.3f} | {chi2:.2f} | {against(z0, err, reference)} |")
         panels.append((eta, reference, series))
     if args.plot:
         import matplotlib
@@ -118,8 +123,9 @@ def main():
                                     capsize=3, label=label)
                 color = drawn.lines[0].get_color()
                 grid = np.linspace(0.0, max(x), 50)
-                a, _, _ = weighted_fit(x, [p[1] for p in points], [p[2] for p in points], 1)
-                ax.plot(grid, a[0] + a[1] * grid, lw=0.8, color=color, ls=":")
+                if len(points) >= 2:
+                    a, _, _ = weighted_fit(x, [p[1] for p in points], [p[2] for p in points], 1)
+                    ax.plot(grid, a[0] + a[1] * grid, lw=0.8, color=color, ls=":")
                 if len(points) >= 3:
                     a, _, _ = weighted_fit(x, [p[1] for p in points], [p[2] for p in points], 2)
                     ax.plot(grid, a[0] + a[1] * grid + a[2] * grid ** 2, lw=0.8, color=color)
