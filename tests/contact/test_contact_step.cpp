@@ -483,6 +483,53 @@ TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
   EXPECT_NEAR(inexact.lambda_sum, reference.lambda_sum, kDefaultLambdaTolerance * reference.lambda_sum);
 }
 
+// The end check at the first correction (DefectCorrectionOptions::early_end_check): 1000
+// spheres at packing 0.3 (seed 8, |f| = 100, free draining) whose converged first round leaves
+// a pair out that its forces bring below d_hat. Checked at the first corrected iterate, the
+// pair joins there and no second round is needed; the answer is the same step. Matrix-free
+// (where the check waits for the end) and with the check off, the second round remains.
+TEST(ContactStep, EndCheckAtTheFirstCorrectionSavesTheGuaranteeRound) {
+  const std::size_t n = 1000;
+  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  const sc::SpherePacking packing = sc::random_sequential_addition(n, 0.3, 8);
+  sc::Rng rng(8);
+  const std::vector<sc::Vec3> f = sc::random_forces(n, 100.0, rng);
+  sc::VecX F(3 * static_cast<Eigen::Index>(n));
+  for (std::size_t k = 0; k < n; ++k) F.segment<3>(3 * static_cast<Eigen::Index>(k)) = f[k];
+  sc::FreeDrainingMobility mobility(sc::sphere_mobility(shapes[0], 1.0), n, 3);
+  mobility.set_configuration(packing.poses);
+  const sc::VecX U = mobility.apply(F);
+  const sc::ContactStepProblem<sc::Sphere> problem{shapes, packing.poses, U, 0.01, 0.01};
+  sc::DefectCorrectionOptions late;
+  late.early_end_check = false;
+  const sc::ContactStepResult early = sc::solve_contact_step_defect_correction(problem, mobility);
+  const sc::ContactStepResult reference = sc::solve_contact_step_defect_correction(problem, mobility, {}, late);
+  sc::ContactStepOptions probed_options;
+  probed_options.cost = sc::MobilityCost::matrix_free;
+  const sc::ContactStepResult probed = sc::solve_contact_step_defect_correction(problem, mobility, probed_options);
+  std::printf("early end check: %d corrections, %d guarantee rounds; at the end: %d, %d; matrix-free %d, %d\n",
+              early.iterations, early.guarantee_rounds, reference.iterations, reference.guarantee_rounds,
+              probed.iterations, probed.guarantee_rounds);
+  EXPECT_EQ(reference.guarantee_rounds, 1);  // the scene misses a pair
+  EXPECT_EQ(probed.guarantee_rounds, 1);
+  EXPECT_EQ(early.guarantee_rounds, 0);
+  EXPECT_LT(early.iterations, reference.iterations);
+  for (const sc::ContactStepResult* r : {&early, &reference, &probed}) {
+    EXPECT_EQ(r->status, sc::ContactStepStatus::converged) << r->message;
+    EXPECT_GE(r->min_distance_ratio, 1.0);
+    EXPECT_LE(r->complementarity_residual, 1e-3);
+    expect_third_law(*r, 3);
+  }
+  ASSERT_EQ(early.flagged_pairs, reference.flagged_pairs);
+  ASSERT_EQ(early.lambda.size(), reference.lambda.size());
+  for (std::size_t k = 0; k < early.pairs.size(); ++k) {
+    EXPECT_EQ(early.pairs[k].i, reference.pairs[k].i);
+    EXPECT_EQ(early.pairs[k].j, reference.pairs[k].j);
+  }
+  EXPECT_LE((early.lambda - reference.lambda).lpNorm<Eigen::Infinity>(), 1e-3 * reference.lambda_max);
+  EXPECT_NEAR(early.lambda_sum, reference.lambda_sum, kDefaultLambdaTolerance * reference.lambda_sum);
+}
+
 // The cost mode follows the model: blocks for a block-diagonal one (free draining); for any
 // other, formed up to automatic_formed_max_pairs flagged pairs and matrix_free beyond. blocks
 // asked of a model without blocks is refused, naming the option.

@@ -172,10 +172,12 @@ ContactPair remeasured(const ContactPair& p, std::span<const S> shapes, std::spa
 }
 
 // All pairs with d^P <= d_try (d_try >= 0), sorted by (i, j). `cells`, when given, keeps
-// the broad phase's buffers between calls.
+// the broad phase's buffers between calls. With `marked` (one entry per body), only the pairs
+// that have a marked body (CellList::find_pairs_of: O(N) to sort, then O(marked)).
 template <Shape S>
 std::vector<ContactPair> find_contact_pairs(std::span<const S> shapes, std::span<const Pose> poses, double d_try,
-                                            const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr) {
+                                            const std::optional<PeriodicBox>& box = {}, CellList* cells = nullptr,
+                                            std::span<const char> marked = {}) {
   validate_scene(shapes, poses);
   require_non_negative(d_try, "d_try");
   Mat3X centres;
@@ -183,7 +185,8 @@ std::vector<ContactPair> find_contact_pairs(std::span<const S> shapes, std::span
   detail::broad_phase_input(shapes, poses, centres, radii);
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
-  const std::vector<BodyPair>& candidates = list.find_pairs(centres, radii, d_try, box);
+  const std::vector<BodyPair>& candidates = marked.empty() ? list.find_pairs(centres, radii, d_try, box)
+                                                           : list.find_pairs_of(centres, radii, d_try, box, marked);
   std::vector<ContactPair> flagged;
   const auto measure = [&](const BodyPair& c) { return detail::contact_pair(shapes, poses, c.i, c.j, box); };
   if constexpr (std::is_same_v<S, Sphere>) {

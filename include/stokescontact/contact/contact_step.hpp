@@ -649,6 +649,21 @@ class ContactStep {
   // that measures.
   const std::vector<char>& moved_by(const VecX& MD_lambda) const { return mark_moved(MD_lambda); }
 
+  // The end check of run_contact_step at an iterate (e, an evaluation of this step), early:
+  // adds the pairs not flagged that are below d_hat (1 - separation_margin) at Q(lambda) and
+  // returns how many. Only where unflagged pairs stay clear along the trial motion
+  // (DTryRule::relative): then such a pair has a body that M D lambda moves, and only those
+  // bodies' neighbourhoods are searched (O(moved bodies) after the cell list's O(N) sort).
+  // Elsewhere 0: the end check finds them.
+  std::size_t add_pairs_closing_at(const ContactEvaluation& e) {
+    if (!unflagged_stay_clear_) return 0;
+    std::vector<ContactPair> closing =
+        find_contact_pairs(problem_.shapes, std::span<const Pose>(e.poses), problem_.d_hat * (1.0 - options_.separation_margin),
+                           problem_.box, &cells_, mark_moved(e.MD_lambda));
+    std::erase_if(closing, [&](const ContactPair& p) { return separated(p.points.distance); });
+    return add_pairs(closing);
+  }
+
   // Whether every pair the step has not flagged stays above d_hat along the trial motion
   // (DTryRule::relative, find_pairs_relative): then only the flagged pairs and the pairs of
   // bodies a correction moves can cross along a corrected motion (CrossingScope).
