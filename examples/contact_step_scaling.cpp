@@ -5,7 +5,7 @@
 //
 //   contact_step_scaling [--sizes 1000,10000,100000] [--phi 0.3] [--cost blocks,matrix-free,formed]
 //                        [--formed-max 10000] [--solver default] [--max-memory-mb 0]
-//                        [--repeat 3] [--output FILE]
+//                        [--repeat 3] [--late-end-check] [--output FILE]
 //
 // Per N and cost mode: the unconstrained step (M at Q_t, U = M f and Q* = Q_t + dt U), the
 // contact step (detection, solve and the whole-step guarantee), flagged and pushed pairs,
@@ -19,6 +19,8 @@
 // simulation's steps after its first meet a warm heap; the first contact step's time (the
 // process touching its memory for the first time: page faults) is reported as well. The
 // repeats must give the same forces (ERROR otherwise).
+// --late-end-check: the default solver checks the end only after a round has converged
+// (DefectCorrectionOptions::early_end_check off), to compare with the library's default.
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
 #include <stokescontact/contact/solvers/contact_solver.hpp>
 #include <stokescontact/io/json.hpp>
@@ -30,7 +32,9 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "common/cli.hpp"
@@ -43,7 +47,7 @@ namespace contact_step_scaling {
 constexpr const char* kUsage =
     "usage: contact_step_scaling [--sizes 1000,10000,100000] [--phi 0.3] [--cost blocks,matrix-free,formed]\n"
     "                            [--formed-max 10000] [--solver default] [--max-memory-mb 0] [--repeat 3]\n"
-    "                            [--output FILE]\n";
+    "                            [--late-end-check] [--output FILE]\n";
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -67,6 +71,7 @@ struct Options {
   std::string solver_name = "default";
   double max_memory_mb = 0.0;
   int repeat = 3;
+  bool late_end_check = false;
   std::string output;
 };
 
@@ -92,6 +97,9 @@ Options parse(int argc, char** argv) {
   sc::contact_solver_from_name(o.solver_name);
   o.max_memory_mb = args.number("--max-memory-mb", 0.0, 0.0);
   o.repeat = static_cast<int>(args.integer("--repeat", 3, 1));
+  o.late_end_check = args.flag("--late-end-check");
+  if (o.late_end_check && !std::holds_alternative<sc::DefectCorrectionOptions>(sc::contact_solver_from_name(o.solver_name)))
+    throw std::invalid_argument("--late-end-check: only the default solver checks the end early, not " + o.solver_name);
   o.output = args.text("--output", "");
   args.reject_unknown();
   return o;
@@ -99,7 +107,8 @@ Options parse(int argc, char** argv) {
 
 // 0 when every step converged within the memory bound, 1 otherwise ("ERROR" lines say why).
 int run(const Options& o) {
-  const sc::ContactSolver solver = sc::contact_solver_from_name(o.solver_name);
+  sc::ContactSolver solver = sc::contact_solver_from_name(o.solver_name);
+  if (o.late_end_check) std::get<sc::DefectCorrectionOptions>(solver).early_end_check = false;
   ex::JsonLines sink(o.output);
   const double dt = 0.01, d_hat = 0.01, force = 100.0;
   std::printf("Contact step scaling: spheres at phi %g, |f| = %g, free draining, dt = d_hat = %g, solver %s,\n"
@@ -151,7 +160,8 @@ int run(const Options& o) {
                 sc::mobility_cost_name(r.cost) + "\", \"solver\": \"" + o.solver_name + "\", \"unconstrained_s\": " +
                 sc::json_number(unconstrained_s) + ", \"contact_step_s\": " + sc::json_number(contact_s) +
                 ", \"first_contact_step_s\": " + sc::json_number(contact_times.front()) +
-                ", \"repeats\": " + std::to_string(o.repeat) +
+                ", \"repeats\": " + std::to_string(o.repeat) + ", \"early_end_check\": " +
+                (o.late_end_check ? "false" : "true") +
                 ", \"flagged_pairs\": " + std::to_string(r.flagged_pairs) + ", \"pushed_pairs\": " +
                 std::to_string(pushed) + ", \"mobility_applications\": " + std::to_string(r.mobility_applications) +
                 ", \"iterations\": " + std::to_string(r.iterations) + ", \"guarantee_rounds\": " +

@@ -416,4 +416,63 @@ TEST(ContactMatrix, AssemblyIsTheTripletsMatrixEntryForEntry) {
   EXPECT_EQ(sc::assemble_contact_matrix({}, 5, 6).nonZeros(), 0);
 }
 
+// A contact step appends pairs: D grown column batch by column batch is the matrix assembled
+// at once, entry for entry, and M D of a block-diagonal M grown with it is Eigen's sparse
+// product M * D, entry for entry (bit for bit: the same sums in the same order), for a dense
+// 6 x 6 block per body and for a diagonal one (spheres' 3 x 3). A matrix that is not block
+// diagonal, or an MD that is not D's first columns, is refused naming it.
+TEST(ContactMatrix, AppendedColumnsAndBlockProductAreTheWholeAssembly) {
+  std::mt19937_64 rng(37);
+  for (const int dofs : {3, 6}) {
+    const std::size_t bodies = 30;
+    const auto rows = static_cast<Eigen::Index>(bodies) * dofs;
+    std::vector<sc::ContactColumn> columns;
+    for (int k = 0; k < 200; ++k) {
+      const auto i = static_cast<Eigen::Index>(rng() % bodies);
+      const auto j = static_cast<Eigen::Index>((static_cast<std::size_t>(i) + 1 + rng() % (bodies - 1)) % bodies);
+      columns.push_back({i, j, uniform_vector(rng, -1.0, 1.0), uniform_vector(rng, -1.0, 1.0),
+                         uniform_vector(rng, -1.0, 1.0)});
+    }
+    std::vector<Eigen::Triplet<double>> blocks;
+    for (Eigen::Index b = 0; b < static_cast<Eigen::Index>(bodies); ++b)
+      for (int r = 0; r < dofs; ++r)
+        for (int c = 0; c < dofs; ++c)
+          if (dofs == 6 || r == c) blocks.emplace_back(b * dofs + r, b * dofs + c, uniform(rng, -1.0, 1.0));
+    Eigen::SparseMatrix<double> M(rows, rows);
+    M.setFromTriplets(blocks.begin(), blocks.end());
+    const Eigen::SparseMatrix<double> whole = sc::assemble_contact_matrix(columns, bodies, dofs);
+    const Eigen::SparseMatrix<double> product = M * whole;
+    Eigen::SparseMatrix<double> d, md;
+    for (const std::size_t upto : {std::size_t{0}, std::size_t{70}, std::size_t{71}, std::size_t{200}}) {
+      const std::span<const sc::ContactColumn> batch(columns.data(), upto);
+      sc::append_contact_columns(d, batch, bodies, dofs);
+      sc::append_block_diagonal_product(md, M, d, bodies);
+      ASSERT_EQ(d.cols(), static_cast<Eigen::Index>(upto));
+      ASSERT_EQ(md.cols(), static_cast<Eigen::Index>(upto));
+    }
+    ASSERT_EQ(d.nonZeros(), whole.nonZeros());
+    for (Eigen::Index k = 0; k <= d.cols(); ++k) EXPECT_EQ(d.outerIndexPtr()[k], whole.outerIndexPtr()[k]);
+    for (Eigen::Index e = 0; e < d.nonZeros(); ++e) {
+      EXPECT_EQ(d.innerIndexPtr()[e], whole.innerIndexPtr()[e]);
+      EXPECT_EQ(d.valuePtr()[e], whole.valuePtr()[e]);
+    }
+    for (Eigen::Index k = 0; k < product.outerSize(); ++k)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(product, k); it; ++it)
+        EXPECT_EQ(md.coeff(it.row(), it.col()), it.value()) << "dofs " << dofs << ", (" << it.row() << ", " << it.col() << ")";
+    EXPECT_EQ(Eigen::MatrixXd(md - product).cwiseAbs().maxCoeff(), 0.0);
+
+    Eigen::SparseMatrix<double> coupled = M;
+    coupled.coeffRef(0, dofs) = 1.0;  // body 0 driven by body 1: not block diagonal
+    Eigen::SparseMatrix<double> empty;
+    expect_rejects([&] { sc::append_block_diagonal_product(empty, coupled, whole, bodies); }, "M");
+    Eigen::SparseMatrix<double> longer = product;  // more columns than the D it should belong to
+    longer.makeCompressed();
+    const Eigen::SparseMatrix<double> first_ten = whole.leftCols(10);
+    expect_rejects([&] { sc::append_block_diagonal_product(longer, M, first_ten, bodies); }, "MD");
+    Eigen::SparseMatrix<double> too_many = whole;
+    expect_rejects([&] { sc::append_contact_columns(too_many, std::span<const sc::ContactColumn>(columns.data(), 10), bodies, dofs); },
+                   "d");
+  }
+}
+
 }  // namespace contact_matrix_tests

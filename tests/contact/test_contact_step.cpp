@@ -485,9 +485,11 @@ TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
 
 // The end check at the first correction (DefectCorrectionOptions::early_end_check): 1000
 // spheres at packing 0.3 (seed 8, |f| = 100, free draining) whose converged first round leaves
-// a pair out that its forces bring below d_hat. Checked at the first corrected iterate, the
-// pair joins there and no second round is needed; the answer is the same step. Matrix-free
-// (where the check waits for the end) and with the check off, the second round remains.
+// a pair out that its forces bring below d_hat. Checked at the first corrected iterate (here
+// from any number of pushed pairs), the pair joins there and no second round is needed; the
+// answer is the same step. Matrix-free (where the check waits for the end: it is made in blocks
+// mode only), with the check off and with the default threshold of pushed pairs (this step
+// pushes fewer), the second round remains.
 TEST(ContactStep, EndCheckAtTheFirstCorrectionSavesTheGuaranteeRound) {
   const std::size_t n = 1000;
   const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
@@ -500,10 +502,12 @@ TEST(ContactStep, EndCheckAtTheFirstCorrectionSavesTheGuaranteeRound) {
   mobility.set_configuration(packing.poses);
   const sc::VecX U = mobility.apply(F);
   const sc::ContactStepProblem<sc::Sphere> problem{shapes, packing.poses, U, 0.01, 0.01};
-  sc::DefectCorrectionOptions late;
+  sc::DefectCorrectionOptions late, at_any_size;
   late.early_end_check = false;
-  const sc::ContactStepResult early = sc::solve_contact_step_defect_correction(problem, mobility);
+  at_any_size.early_end_check_min_pushed = 0;
+  const sc::ContactStepResult early = sc::solve_contact_step_defect_correction(problem, mobility, {}, at_any_size);
   const sc::ContactStepResult reference = sc::solve_contact_step_defect_correction(problem, mobility, {}, late);
+  const sc::ContactStepResult by_default = sc::solve_contact_step_defect_correction(problem, mobility);
   sc::ContactStepOptions probed_options;
   probed_options.cost = sc::MobilityCost::matrix_free;
   const sc::ContactStepResult probed = sc::solve_contact_step_defect_correction(problem, mobility, probed_options);
@@ -512,6 +516,9 @@ TEST(ContactStep, EndCheckAtTheFirstCorrectionSavesTheGuaranteeRound) {
               probed.iterations, probed.guarantee_rounds);
   EXPECT_EQ(reference.guarantee_rounds, 1);  // the scene misses a pair
   EXPECT_EQ(probed.guarantee_rounds, 1);
+  EXPECT_LT((reference.lambda.array() > 0.0).count(), 1000);  // below the default threshold ...
+  EXPECT_EQ(by_default.guarantee_rounds, 1);                   // ... so checked at the end
+  EXPECT_EQ(by_default.lambda, reference.lambda);
   EXPECT_EQ(early.guarantee_rounds, 0);
   EXPECT_LT(early.iterations, reference.iterations);
   for (const sc::ContactStepResult* r : {&early, &reference, &probed}) {

@@ -39,6 +39,8 @@
 
 #include <Eigen/Sparse>
 
+#include "stokescontact/core/parallel_for.hpp"
+
 #include "stokescontact/contact/barrier.hpp"
 #include "stokescontact/contact/contact_pairs.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
@@ -148,26 +150,34 @@ inline BarrierParameters surface_weight_barrier(double d_try, const SurfaceWeigh
 
 }  // namespace detail
 
-// D from its columns: (dofs_per_body N) x columns.size(), dofs_per_body = 3 or 6.
-inline Eigen::SparseMatrix<double> assemble_contact_matrix(std::span<const ContactColumn> columns,
-                                                           std::size_t bodies, int dofs_per_body) {
+// D with columns[d.cols()..] appended: d holds the columns before them already (a contact
+// step only ever appends pairs), which are copied, not computed again. (dofs_per_body N) x
+// columns.size(), dofs_per_body = 3 or 6; each column holds both bodies' dofs_per_body rows,
+// ascending (the lower body's first), as setFromTriplets would order the same entries.
+inline void append_contact_columns(Eigen::SparseMatrix<double>& d, std::span<const ContactColumn> columns,
+                                   std::size_t bodies, int dofs_per_body) {
   if (dofs_per_body != 3 && dofs_per_body != 6)
     fail_argument("dofs_per_body", "must be 3 or 6, got " + std::to_string(dofs_per_body));
-  // Compressed column storage filled directly, rows ascending within each column (the lower
-  // body's dofs first): what setFromTriplets makes of the same entries, without its sort.
   const Eigen::Index per_body = dofs_per_body, per_column = 2 * per_body;
-  const auto nc = static_cast<Eigen::Index>(columns.size());
-  Eigen::SparseMatrix<double> d(static_cast<Eigen::Index>(bodies) * dofs_per_body, nc);
-  d.resizeNonZeros(nc * per_column);
-  int* const outer = d.outerIndexPtr();
-  int* const inner = d.innerIndexPtr();
-  double* const value = d.valuePtr();
-  for (Eigen::Index k = 0; k < nc; ++k) {
+  const auto rows = static_cast<Eigen::Index>(bodies) * per_body;
+  const auto nc = static_cast<Eigen::Index>(columns.size()), first = d.cols();
+  if (first > nc || (first > 0 && d.rows() != rows) || !d.isCompressed() || d.nonZeros() != first * per_column)
+    fail_argument("d", "must hold the first columns of the contact matrix, compressed (" + std::to_string(d.rows()) +
+                           " x " + std::to_string(d.cols()) + " for " + std::to_string(nc) + " columns of " +
+                           std::to_string(rows) + " rows)");
+  Eigen::SparseMatrix<double> out(rows, nc);
+  out.resizeNonZeros(nc * per_column);
+  int* const outer = out.outerIndexPtr();
+  int* const inner = out.innerIndexPtr();
+  double* const value = out.valuePtr();
+  std::copy_n(d.innerIndexPtr(), first * per_column, inner);
+  std::copy_n(d.valuePtr(), first * per_column, value);
+  for (Eigen::Index k = 0; k <= nc; ++k) outer[k] = static_cast<int>(k * per_column);
+  const auto n = static_cast<Eigen::Index>(bodies);
+  for (Eigen::Index k = first; k < nc; ++k) {
     const ContactColumn& c = columns[static_cast<std::size_t>(k)];
-    const auto n = static_cast<Eigen::Index>(bodies);
     if (!(0 <= c.i && c.i < n && 0 <= c.j && c.j < n && c.i != c.j))
       detail::require_pair_indices(c.i, c.j, bodies, "columns[" + std::to_string(k) + "]");
-    outer[k] = static_cast<int>(k * per_column);
     // Body b's entries: -force_j, torque_i (body i) or force_j, torque_j (body j).
     const auto body_entries = [&](Eigen::Index b, Eigen::Index at) {
       const bool is_i = b == c.i;
@@ -179,8 +189,61 @@ inline Eigen::SparseMatrix<double> assemble_contact_matrix(std::span<const Conta
     body_entries(std::min(c.i, c.j), k * per_column);
     body_entries(std::max(c.i, c.j), k * per_column + per_body);
   }
-  outer[nc] = static_cast<int>(nc * per_column);
+  d = std::move(out);
+}
+
+// D from its columns: (dofs_per_body N) x columns.size(), dofs_per_body = 3 or 6.
+inline Eigen::SparseMatrix<double> assemble_contact_matrix(std::span<const ContactColumn> columns,
+                                                           std::size_t bodies, int dofs_per_body) {
+  Eigen::SparseMatrix<double> d;
+  append_contact_columns(d, columns, bodies, dofs_per_body);
   return d;
+}
+
+// M D for a block-diagonal M (one block per body: free draining), with D's columns from
+// MD.cols() on appended to MD: column k of M D is nonzero on the rows of D's column k only (its
+// two bodies' blocks), so M D has D's pattern and each column is computed alone, O(new
+// columns). The same sums in the same order as Eigen's sparse product M * D (D's entries of a
+// column in order, each times M's column); M must be block diagonal with blocks of
+// D.rows() / bodies rows (std::invalid_argument otherwise).
+inline void append_block_diagonal_product(Eigen::SparseMatrix<double>& MD, const Eigen::SparseMatrix<double>& M,
+                                          const Eigen::SparseMatrix<double>& D, std::size_t bodies) {
+  const Eigen::Index first = MD.cols(), nc = D.cols();
+  if (M.rows() != D.rows() || M.cols() != D.rows() || bodies == 0 || D.rows() % static_cast<Eigen::Index>(bodies) != 0)
+    fail_argument("M", "is " + std::to_string(M.rows()) + " x " + std::to_string(M.cols()) + " for D of " +
+                           std::to_string(D.rows()) + " rows and " + std::to_string(bodies) + " bodies");
+  if (first > nc || (first > 0 && MD.rows() != D.rows()) || !MD.isCompressed() || !D.isCompressed() ||
+      MD.nonZeros() != D.outerIndexPtr()[first])
+    fail_argument("MD", "must hold M D of D's first columns, compressed");
+  const Eigen::Index per_body = D.rows() / static_cast<Eigen::Index>(bodies);
+  Eigen::SparseMatrix<double> out(D.rows(), nc);
+  out.resizeNonZeros(D.nonZeros());
+  std::copy_n(D.outerIndexPtr(), nc + 1, out.outerIndexPtr());
+  std::copy_n(D.innerIndexPtr(), D.nonZeros(), out.innerIndexPtr());
+  std::copy_n(MD.valuePtr(), MD.nonZeros(), out.valuePtr());
+  const int* const outer = D.outerIndexPtr();
+  const int* const inner = D.innerIndexPtr();
+  double* const value = out.valuePtr();
+  std::vector<char> outside(static_cast<std::size_t>(nc - first), 0);
+  parallel_for(nc - first, [&](std::ptrdiff_t index) {
+    const Eigen::Index k = first + index;
+    const int begin = outer[k], end = outer[k + 1];
+    for (int e = begin; e < end; ++e) value[e] = 0.0;
+    for (int e = begin; e < end; ++e) {
+      const double y = D.valuePtr()[e];
+      for (Eigen::SparseMatrix<double>::InnerIterator m(M, inner[e]); m; ++m) {
+        const int* const at = std::find(inner + begin, inner + end, static_cast<int>(m.row()));
+        if (at == inner + end || m.row() / per_body != inner[e] / per_body) {
+          outside[static_cast<std::size_t>(index)] = 1;
+          continue;
+        }
+        value[at - inner] += m.value() * y;
+      }
+    }
+  });
+  if (std::find(outside.begin(), outside.end(), 1) != outside.end())
+    fail_argument("M", "is not block diagonal with blocks of " + std::to_string(per_body) + " rows");
+  MD = std::move(out);
 }
 
 // Broms eq. 20-21: the column of a pair from its closest points.

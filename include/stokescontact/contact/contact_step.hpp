@@ -375,7 +375,7 @@ class ContactStep {
     if constexpr (BlockDiagonalMobility<M>)
       if (cost_ == MobilityCost::blocks) {
         M_blocks_ = mobility.block_diagonal();
-        MD_ = M_blocks_ * D_;
+        append_block_diagonal_product(MD_, M_blocks_, D_, trial_.size());
       }
   }
 
@@ -710,8 +710,8 @@ class ContactStep {
  private:
   // Pairs are only ever appended (after the constructor's first call): the columns of D, the
   // columns of M D already formed and the measurements at Q* of the pairs before stay valid,
-  // so only the new pairs' are computed (in parallel); D and, in blocks mode, M D are then
-  // assembled again, O(Nc) sparse work.
+  // so only the new pairs' are computed (in parallel) and appended to D and, in blocks mode,
+  // to M D (the earlier ones copied: O(Nc) memory traffic, O(new pairs) arithmetic).
   // A carried contact's column: its gap's gradient, in both modes (particle_contact_column
   // on its carried pair, whose two forces act at one point, the middle of the carried
   // points, so that the column keeps Newton's third law for torques too).
@@ -739,8 +739,9 @@ class ContactStep {
         columns_[k] = detail::surface_contact_column(contact, trial, *weight_barrier, options_.surface_weights, field);
       }
     });
-    D_ = assemble_contact_matrix(columns_, trial_.size(), dofs_);
-    if (M_blocks_.rows() > 0) MD_ = M_blocks_ * D_;  // blocks mode, once M is set (the constructor's end)
+    append_contact_columns(D_, columns_, trial_.size(), dofs_);
+    // blocks mode, once M is set (the constructor's end)
+    if (M_blocks_.rows() > 0) append_block_diagonal_product(MD_, M_blocks_, D_, trial_.size());
   }
 
   // With overlap_ends directions, the pairs from `first` on that are not carried become

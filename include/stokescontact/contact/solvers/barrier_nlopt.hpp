@@ -242,9 +242,10 @@ ContactStepResult solve_contact_step_barrier(const ContactStepProblem<S>& proble
                        std::to_string(subproblem.smallest_sum_corrections) + " corrections, the last " +
                        std::to_string(subproblem.complementarity_corrections) + " solved the LCP (complementarity)";
       if (out.converged) return out;
-      // The default solver's round from the same warm start: complementarity, separated.
-      ContactSolveOutcome lcp =
-          detail::solve_defect_correction_round(step, warm, corrections, detail::WorkingSetLcp{corrections.lcp, subproblem.name});
+      // The default solver's round from the same warm start: complementarity, separated. (The
+      // round may have added pairs: DefectCorrectionOptions::early_end_check.)
+      ContactSolveOutcome lcp = detail::solve_defect_correction_round(step, detail::padded(warm, step.nc()), corrections,
+                                                                      detail::WorkingSetLcp{corrections.lcp, subproblem.name});
       lcp.iterations += out.iterations;
       lcp.message = std::string(subproblem.name) + ": the smallest sum was not reached (" + out.message +
                     "), solved again to complementarity" + (lcp.message.empty() ? "" : ": " + lcp.message);

@@ -116,14 +116,22 @@ struct DefectCorrectionOptions {
   // The guarantee's end check (contact_step.hpp) at the round's first corrected iterate: pairs
   // not flagged that the first correction's forces bring below d_hat join the step there, and
   // the round starts again from that iterate, instead of after the round has converged without
-  // them (then a second round, warm-started, solves again with them). On 1e5 spheres at packing
-  // 0.3 a converged first round left 7 such pairs out of 3e4 flagged (docs/results.md, "The end
-  // check at the first correction"). Only with DTryRule::relative, where such pairs are
-  // those of the bodies the forces move (ContactStep::add_pairs_closing_at), and where the
-  // working-set model is exact (blocks, formed): matrix-free, the round started again from its
-  // first iterate probes anew and its shared probes contract slowly (the same 1e5 spheres: 8
-  // corrections, then the LCP sequence, 63 applications against 25 in two rounds).
+  // them (then a second round, warm-started, solves again with them: about a third of a step's
+  // time on free-draining spheres). Only with DTryRule::relative, where such pairs are those
+  // of the bodies the forces move (ContactStep::add_pairs_closing_at), and in blocks mode,
+  // where the working-set model is exact and free. Formed, each pair that joins costs a column
+  // (an application), and pairs close at the first iterate need not be at the last (Fig. 8
+  // with overlap-ends: 6% more applications); matrix-free, the round started again probes anew
+  // and its shared probes contract slowly (1e5 spheres: 8 corrections, then the LCP sequence,
+  // 63 applications against 25).
+  // The check costs a query over the moved bodies after an O(N) sort, about 8% of a step of 1e4
+  // spheres; it is made where the first iterate pushes at least early_end_check_min_pushed
+  // pairs. On spheres at packing 0.3 (|f| = 100, dt = d_hat = 0.01) a step missed a pair in 1
+  // of 40 scenes of 1e3 spheres (about 84 pushed pairs), 2 of 20 at 3e3 (190), 3 of 12 at 1e4
+  // (770) and every one from 3e4 (2400) on (docs/results.md, "The end check at the first
+  // correction").
   bool early_end_check = true;
+  std::size_t early_end_check_min_pushed = 1000;
   // A step this solver fails is solved again through solve_contact_step (contact_solver.hpp,
   // solve_failed_step_again), the first answer that does not fail kept: a far root (its
   // correction turns a body by more than ContactStepOptions::max_correction_turn) by eq. 15
@@ -445,6 +453,9 @@ template <Shape S, MobilityOperator M, class Subproblem>
 ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX lambda,
                                                   const DefectCorrectionOptions& options, const Subproblem& subproblem,
                                                   RoundChoices choices) {
+  if (lambda.size() != step.nc())
+    fail_argument("lambda", "has " + std::to_string(lambda.size()) + " entries for " + std::to_string(step.nc()) +
+                                " flagged pairs (a warm start from before pairs were added? pad it: detail::padded)");
   const bool search_rays = choices.search_rays;
   ContactSolveOutcome out;
   const double ray_tol = 1e-9;  // relative width of a crossing's bracket: the samples are cheap
@@ -471,7 +482,9 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
   for (;;) {
     const ContactEvaluation& e = step.evaluate(lambda);
     if (options.early_end_check && choices.early_end_check && out.iterations == 1 &&
-        step.cost() != MobilityCost::matrix_free && step.add_pairs_closing_at(e) > 0) {
+        step.cost() == MobilityCost::blocks &&
+        static_cast<std::size_t>((lambda.array() > 0.0).count()) >= options.early_end_check_min_pushed &&
+        step.add_pairs_closing_at(e) > 0) {
       ContactSolveOutcome again = solve_defect_correction_round(step, padded(lambda, step.nc()), options, subproblem,
                                                                 {search_rays, false});
       again.iterations += out.iterations;
