@@ -3,7 +3,8 @@
 // spheres at packing 0.3 (random sequential addition, seed N), random forces |f| = 100, free
 // draining, dt = d_hat = 0.01: the scene of examples/contact_step_scaling, per cost mode
 // (contact_step.hpp). The scene and U are built once; each iteration is one contact step from
-// the same Q_t. Counters: flagged and pushed pairs, mobility applications, time per sphere.
+// the same Q_t. Counters: flagged and pushed pairs, mobility applications, time per sphere,
+// guarantee rounds.
 // N = 1e6 is registered but takes seconds per iteration: select it with --benchmark_filter.
 // Also the step's two O(N) geometry passes on the same packing (contact/contact_pairs.hpp):
 // detection (find_contact_pairs at d_try = 0.1) and the smallest distance over all pairs
@@ -39,7 +40,7 @@ void count_page_faults(benchmark::State& state, long first) {
                                                      benchmark::Counter::kAvgIterations);
 }
 
-void run(benchmark::State& state, MobilityCost cost) {
+void run(benchmark::State& state, MobilityCost cost, const DefectCorrectionOptions& solver = {}) {
   const auto n = static_cast<std::size_t>(state.range(0));
   const double dt = 0.01, d_hat = 0.01;
   const std::vector<Sphere> shapes{Sphere{1.0}};
@@ -57,7 +58,7 @@ void run(benchmark::State& state, MobilityCost cost) {
   ContactStepResult r;
   const long faults = minor_faults();
   for (auto _ : state) {
-    r = solve_contact_step_defect_correction(problem, mobility, options);
+    r = solve_contact_step_defect_correction(problem, mobility, options, solver);
     benchmark::DoNotOptimize(r.lambda.data());
   }
   count_page_faults(state, faults);
@@ -65,12 +66,20 @@ void run(benchmark::State& state, MobilityCost cost) {
   state.counters["flagged"] = static_cast<double>(r.flagged_pairs);
   state.counters["pushed"] = static_cast<double>((r.lambda.array() > 0.0).count());
   state.counters["applications"] = static_cast<double>(r.mobility_applications);
+  state.counters["rounds"] = static_cast<double>(r.guarantee_rounds);
   state.counters["time_per_sphere"] = benchmark::Counter(
       static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 void BM_ContactStepBlocks(benchmark::State& state) { run(state, MobilityCost::blocks); }
 void BM_ContactStepMatrixFree(benchmark::State& state) { run(state, MobilityCost::matrix_free); }
+// The default solver checking the end only after its rounds have converged
+// (DefectCorrectionOptions::early_end_check off): from 3e4 spheres on, a second round.
+void BM_ContactStepBlocksLateEndCheck(benchmark::State& state) {
+  DefectCorrectionOptions late;
+  late.early_end_check = false;
+  run(state, MobilityCost::blocks, late);
+}
 void BM_ContactStepFormed(benchmark::State& state) { run(state, MobilityCost::formed); }
 
 // The packing of N spheres of run(), built once per size.
@@ -113,6 +122,7 @@ BENCHMARK(BM_FindContactPairs)->RangeMultiplier(10)->Range(10000, 1000000)->Unit
 BENCHMARK(BM_MinimumPairDistance)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ContactStepBlocks)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ContactStepMatrixFree)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ContactStepBlocksLateEndCheck)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
 // Formed holds one dense column of M D per working-set pair: O(N x pairs), 1e4 at most here.
 BENCHMARK(BM_ContactStepFormed)->RangeMultiplier(10)->Range(1000, 10000)->Unit(benchmark::kMillisecond);
 

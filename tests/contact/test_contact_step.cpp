@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <numbers>
@@ -483,6 +484,27 @@ TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
   EXPECT_NEAR(inexact.lambda_sum, reference.lambda_sum, kDefaultLambdaTolerance * reference.lambda_sum);
 }
 
+// N unit spheres at packing 0.3 (random sequential addition) under random forces |f| = 100,
+// both of seed `seed`, free draining, dt = d_hat = 0.01: the scene of
+// examples/contact_step_scaling (which takes seed N).
+struct SphereSuspension {
+  std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
+  sc::SpherePacking packing;
+  sc::FreeDrainingMobility mobility;
+  sc::VecX U;
+
+  SphereSuspension(std::size_t n, std::uint64_t seed)
+      : packing(sc::random_sequential_addition(n, 0.3, seed)), mobility(sc::sphere_mobility(shapes[0], 1.0), n, 3) {
+    sc::Rng rng(seed);
+    const std::vector<sc::Vec3> f = sc::random_forces(n, 100.0, rng);
+    sc::VecX F(3 * static_cast<Eigen::Index>(n));
+    for (std::size_t k = 0; k < n; ++k) F.segment<3>(3 * static_cast<Eigen::Index>(k)) = f[k];
+    mobility.set_configuration(packing.poses);
+    U = mobility.apply(F);
+  }
+  sc::ContactStepProblem<sc::Sphere> problem() const { return {shapes, packing.poses, U, 0.01, 0.01}; }
+};
+
 // The end check at the first correction (DefectCorrectionOptions::early_end_check): 1000
 // spheres at packing 0.3 (seed 8, |f| = 100, free draining) whose converged first round leaves
 // a pair out that its forces bring below d_hat. Checked at the first corrected iterate (here
@@ -491,17 +513,9 @@ TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
 // mode only), with the check off and with the default threshold of pushed pairs (this step
 // pushes fewer), the second round remains.
 TEST(ContactStep, EndCheckAtTheFirstCorrectionSavesTheGuaranteeRound) {
-  const std::size_t n = 1000;
-  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
-  const sc::SpherePacking packing = sc::random_sequential_addition(n, 0.3, 8);
-  sc::Rng rng(8);
-  const std::vector<sc::Vec3> f = sc::random_forces(n, 100.0, rng);
-  sc::VecX F(3 * static_cast<Eigen::Index>(n));
-  for (std::size_t k = 0; k < n; ++k) F.segment<3>(3 * static_cast<Eigen::Index>(k)) = f[k];
-  sc::FreeDrainingMobility mobility(sc::sphere_mobility(shapes[0], 1.0), n, 3);
-  mobility.set_configuration(packing.poses);
-  const sc::VecX U = mobility.apply(F);
-  const sc::ContactStepProblem<sc::Sphere> problem{shapes, packing.poses, U, 0.01, 0.01};
+  SphereSuspension suspension(1000, 8);
+  const sc::ContactStepProblem<sc::Sphere> problem = suspension.problem();
+  sc::FreeDrainingMobility& mobility = suspension.mobility;
   sc::DefectCorrectionOptions late, at_any_size;
   late.early_end_check = false;
   at_any_size.early_end_check_min_pushed = 0;
@@ -659,17 +673,9 @@ constexpr bool kSanitized = false;
 #endif
 
 TEST(ContactStepAtScale, HundredThousandSpheresInBoundedMemoryWithoutApplications) {
-  const std::size_t n = 100000;
-  const std::vector<sc::Sphere> shapes{sc::Sphere{1.0}};
-  const sc::SpherePacking packing = sc::random_sequential_addition(n, 0.3, n);
-  sc::Rng rng(n);
-  const std::vector<sc::Vec3> f = sc::random_forces(n, 100.0, rng);
-  sc::VecX F(3 * static_cast<Eigen::Index>(n));
-  for (std::size_t k = 0; k < n; ++k) F.segment<3>(3 * static_cast<Eigen::Index>(k)) = f[k];
-  sc::FreeDrainingMobility mobility(sc::sphere_mobility(shapes[0], 1.0), n, 3);
-  mobility.set_configuration(packing.poses);
-  const sc::VecX U = mobility.apply(F);
-  const sc::ContactStepProblem<sc::Sphere> problem{shapes, packing.poses, U, 0.01, 0.01};
+  SphereSuspension suspension(100000, 100000);
+  const sc::ContactStepProblem<sc::Sphere> problem = suspension.problem();
+  sc::FreeDrainingMobility& mobility = suspension.mobility;
 
   const sc::ContactStepResult r = sc::solve_contact_step_defect_correction(problem, mobility);
   const double memory = peak_memory_mb();
