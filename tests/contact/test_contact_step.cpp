@@ -549,6 +549,13 @@ TEST(ContactStep, EndCheckAtTheFirstCorrectionSavesTheGuaranteeRound) {
   }
   EXPECT_LE((early.lambda - reference.lambda).lpNorm<Eigen::Infinity>(), 1e-3 * reference.lambda_max);
   EXPECT_NEAR(early.lambda_sum, reference.lambda_sum, kDefaultLambdaTolerance * reference.lambda_sum);
+
+  // A round's warm start must match the step's flagged pairs (after pairs were added, padded).
+  sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility> step(problem, mobility, {});
+  expect_rejects([&] {
+    sc::detail::solve_defect_correction_round(step, sc::VecX::Zero(step.nc() + 1), sc::DefectCorrectionOptions{},
+                                              sc::detail::WorkingSetLcp{});
+  }, "lambda");
 }
 
 // The cost mode follows the model: blocks for a block-diagonal one (free draining); for any
