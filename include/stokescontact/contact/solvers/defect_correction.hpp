@@ -37,6 +37,9 @@
 //    with exact products, polished to complementarity (lcp_sequence.hpp).
 //  - each correction's LCP is solved only as far as the corrections' convergence needs
 //    (DefectCorrectionOptions::lcp_forcing), tighter as lambda settles.
+//  - the guarantee's end check is made at the first corrected iterate too (blocks mode, from
+//    1000 pushed pairs: DefectCorrectionOptions::early_end_check): a pair that the forces,
+//    not the trial motion, bring below d_hat joins the step then, not in a second round.
 //
 //  - the distance need not grow monotonically along the force (non-convex shapes: interlocked
 //    boomerangs, whose closest points jump between arms as the bodies turn), so a converged
