@@ -10,7 +10,7 @@
 //                 [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]
 //                 [--overlap-ends-angle 0.1] [--start random|aligned] [--melt 0]
 //                 [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]
-//                 [--output FILE]
+//                 [--separation-margin 1e-3] [--output FILE]
 //
 // --u0 is given as U0 / (L D_R), the paper's Fig. 6 axis (D_R = kT / zeta_r, eq. 49); --dt,
 // --equilibrate, --average, --melt and --melt-dt are in rotational times 1 / D_R. --eta gives
@@ -19,14 +19,19 @@
 // --start aligned, periodic_aligned_columns (every rod along z, Yan et al. Sec. IV.B's aligned
 // start, for dense suspensions), then --melt time units of Brownian motion at --melt-dt
 // without propulsion, unrecorded, whose end is the start of every run (the summary prints its
-// nematic order; --progress K writes every K-th melt step's diagnostics to stderr as JSON).
+// nematic order; --progress K writes every K-th melt step's diagnostics and the nematic order S
+// after it to stderr as JSON).
 // Every (U0, dt) runs from that start; given several --dt, a row "dt -> 0" per U0
 // extrapolates Z = Z_0 + c sqrt(dt) (brownian_pressure.hpp). --directions: the contact
 // directions (overlap-ends holds near-parallel rods at both ends of their overlap, when it is
 // at least --overlap-ends-min-overlap times the radius: ContactStepOptions::overlap_ends_min_overlap,
 // and their axes meet at less than --overlap-ends-angle radians: overlap_ends_angle);
 // --max-substep-halvings: TimeStepperOptions::max_substep_halvings (0: a step the solver
-// fails ends the run at once, with the solver's message). Per run, the collision pressure is
+// fails ends the run at once, with the solver's message); --separation-margin:
+// ContactStepOptions::separation_margin, a step is committed when every gap is at least
+// d_hat (1 - margin) (Yan et al. accept the gap their linearised LCP leaves; a margin of
+// 0.1-0.5 lets the LCP solvers step dense suspensions, at a hard core between D + d_hat (1 -
+// margin) and D + d_hat). Per run, the collision pressure is
 // reported as Yan's
 //     Pi^col / (B2 n kT) = (Z - 1) / (B2 n),   B2 = pi (2 D'^3 / 3 + L D'^2 + L^2 D' / 4),
 // (eq. 53-55; B2 of hard spherocylinders, exact, Onsager 1949) with the hard-core diameter
@@ -80,7 +85,7 @@ constexpr const char* kUsage =
     "                     [--overlap-ends-angle 0.1]\n"
     "                     [--start random|aligned] [--melt 0]\n"
     "                     [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]\n"
-    "                     [--output FILE]\n";
+    "                     [--separation-margin 1e-3] [--output FILE]\n";
 
 struct Options {
   double aspect = 5.0;
@@ -97,6 +102,7 @@ struct Options {
   ex::RodDirections directions = ex::RodDirections::particle;
   double min_overlap = sc::ContactStepOptions{}.overlap_ends_min_overlap;
   double ends_angle = sc::ContactStepOptions{}.overlap_ends_angle;
+  double separation_margin = sc::ContactStepOptions{}.separation_margin;
   std::uint64_t seed = 1;
   double tolerance = 0.0;
   std::string output;
@@ -125,6 +131,8 @@ Options parse(int argc, char** argv) {
     throw std::invalid_argument("--directions line needs line-contact rods; use particle, surface or overlap-ends");
   o.min_overlap = args.number("--overlap-ends-min-overlap", o.min_overlap, 1e-12);
   o.ends_angle = args.number("--overlap-ends-angle", o.ends_angle, 1e-12);
+  o.separation_margin = args.number("--separation-margin", o.separation_margin, 0.0);
+  if (!(o.separation_margin < 1.0)) throw std::invalid_argument("--separation-margin must lie in [0, 1)");
   o.start = args.text("--start", "random");
   if (o.start != "random" && o.start != "aligned")
     throw std::invalid_argument("--start must be random or aligned, got '" + o.start + "'");
@@ -186,6 +194,7 @@ std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, cons
   options.contact_step.directions = ex::contact_directions(o.directions);
   options.contact_step.overlap_ends_min_overlap = o.min_overlap;
   options.contact_step.overlap_ends_angle = o.ends_angle;
+  options.contact_step.separation_margin = o.separation_margin;
   options.max_substep_halvings = o.halvings;
   options.brownian.emplace();
   options.brownian->kT = 1.0;
@@ -240,7 +249,9 @@ int run(const Options& o) {
     const auto t0 = std::chrono::steady_clock::now();
     for (long k = 0; k < steps; ++k) {
       const sc::StepDiagnostics d = melter->step();
-      if (o.progress > 0 && (k + 1) % o.progress == 0) std::fprintf(stderr, "melt %s\n", sc::to_json(d).c_str());
+      if (o.progress > 0 && (k + 1) % o.progress == 0)  // the step's diagnostics and the order it leaves
+        std::fprintf(stderr, "melt {\"nematic_order\": %s, %s\n", sc::json_number(order_parameter(melter->poses())).c_str(),
+                     sc::to_json(d).c_str() + 1);
     }
     start = melter->poses();
     std::printf("melt: %ld steps at dt %g / D_R, nematic order %.4f -> %.4f, %.1f s\n", steps, o.melt_dt,
@@ -280,7 +291,8 @@ int run(const Options& o) {
                 sc::json_number(dt_D_R) + ", \"d_hat\": " + sc::json_number(o.d_hat) + ", \"solver\": \"" +
                 o.solver + "\", \"directions\": \"" + ex::directions_name(o.directions) +
                 "\", \"overlap_ends_min_overlap\": " + sc::json_number(o.min_overlap) +
-                ", \"overlap_ends_angle\": " + sc::json_number(o.ends_angle) + ", \"seed\": " +
+                ", \"overlap_ends_angle\": " + sc::json_number(o.ends_angle) + ", \"separation_margin\": " +
+                sc::json_number(o.separation_margin) + ", \"seed\": " +
                 std::to_string(o.seed) + ", \"steps_averaged\": " +
                 std::to_string(r.steps) + ", \"B2n\": " + sc::json_number(b2n) + ", \"Z\": " + sc::json_number(z) +
                 ", \"Z_error\": " + sc::json_number(z_error) + ", \"pressure_ratio\": " + sc::json_number(ratio) +

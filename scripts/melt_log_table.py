@@ -4,8 +4,17 @@ markdown row per log: steps, steps sub-stepped, steps by status, and the wall ti
 contact steps (all, median, the largest, and the share spent in sub-stepped steps).
 
     /usr/bin/python3 scripts/melt_log_table.py LOG [LOG ...]
+
+With --cost, the columns of a solver comparison instead (scripts/dense_rod_solver_cost.sh):
+medians of flagged pairs, pushed pairs and solver iterations per step, sub-stepped steps, steps
+solved again by another solver, the wall time per step (median) and in all, the smallest
+min d / d_hat and the largest correction turn over the steps, and how the run ended (the
+log's last line when it is not a step: the stepper's message, or the timeout's exit status).
+
+    /usr/bin/python3 scripts/melt_log_table.py --cost LOG [LOG ...]
 """
 import json
+import os
 import statistics
 import sys
 
@@ -30,12 +39,50 @@ def row(path):
             f"{statistics.median(wall):.2f} s | {max(wall):.1f} s | {100 * share:.0f}% |")
 
 
+def run_end(path):
+    """The log's lines after its last step: why the run stopped (empty when it did not)."""
+    with open(path) as f:
+        lines = [line.strip() for line in f if line.strip()]
+    tail = []
+    for line in reversed(lines):
+        if line.startswith("melt {"):
+            break
+        tail.append(line)
+    return " / ".join(reversed(tail)).replace("|", "/")
+
+
+def cost_row(path):
+    steps = steps_of(path)
+    name = os.path.basename(path)
+    end = run_end(path) or "ran to the end"
+    if not steps:
+        return f"| {name} | 0 | | | | | | | | | | {end} |"
+    med = lambda key: statistics.median(s[key] for s in steps)
+    wall = [s["wall_time_s"] for s in steps]
+    substepped = sum(1 for s in steps if s["substeps"] > 1)
+    again = sum(1 for s in steps if s["fallbacks"] > 0)
+    return (f"| {name} | {len(steps)} | {med('flagged_pairs'):.0f} | {med('active_pairs'):.0f} | "
+            f"{med('iterations'):.0f} | {substepped} | {again} | {statistics.median(wall):.3f} | {sum(wall):.1f} | "
+            f"{min(s['min_distance_ratio'] for s in steps):.4f} | {max(s['max_correction_turn'] for s in steps):.3f} | "
+            f"{end} |")
+
+
 def main():
-    if len(sys.argv) < 2:
+    args = sys.argv[1:]
+    cost = "--cost" in args
+    paths = [a for a in args if a != "--cost"]
+    if not paths:
         sys.exit(__doc__)
+    if cost:
+        print("| log | steps | flagged pairs | pushed pairs | iterations | sub-stepped | solved again | "
+              "median step (s) | all steps (s) | min d / d_hat | largest turn (rad) | end |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+        for path in paths:
+            print(cost_row(path))
+        return
     print("| log | steps | sub-stepped | status | wall, all steps | median step | largest step | wall in sub-stepped steps |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
-    for path in sys.argv[1:]:
+    for path in paths:
         print(row(path))
 
 

@@ -89,6 +89,7 @@
 #include "stokescontact/contact/d_try.hpp"
 #include "stokescontact/contact/surface_contacts.hpp"
 #include "stokescontact/core/parallel_for.hpp"
+#include "stokescontact/core/sparse_transpose_product.hpp"
 #include "stokescontact/core/rigid_motion.hpp"
 #include "stokescontact/mobility/mobility_operator.hpp"
 
@@ -466,18 +467,23 @@ class ContactStep {
     }
   }
 
+  // c D^T v: c times the rates of change of the flagged pairs' distances under the rigid
+  // motions v (contact_matrix.hpp), on the calling thread below 65536 pairs
+  // (core/sparse_transpose_product.hpp).
+  VecX D_transpose_times(const VecX& v, double c = 1.0) const { return sparse_transpose_times(D_, v, c); }
+
   // (M D)^T v = D^T M v (M symmetric): free once formed, else one application.
   VecX MD_transpose_times(const VecX& v) {
     if (v.isZero(0.0)) return VecX::Zero(nc());
-    if (cost_ == MobilityCost::blocks) return MD_.transpose() * v;
-    if (cost_ == MobilityCost::matrix_free) return D_.transpose() * mobility_.apply(v);
+    if (cost_ == MobilityCost::blocks) return sparse_transpose_times(MD_, v);
+    if (cost_ == MobilityCost::matrix_free) return D_transpose_times(mobility_.apply(v));
     VecX out(nc());
     for (Eigen::Index k = 0; k < nc(); ++k) out(k) = formed_column(k).dot(v);
     return out;
   }
 
   // A x = dt D^T M D x, the LCP matrix about Q* (eq. 26 with d^P): one application, or free when formed.
-  VecX A_times(const VecX& x) { return problem_.dt * (D_.transpose() * MD_times(x)); }
+  VecX A_times(const VecX& x) { return D_transpose_times(MD_times(x), problem_.dt); }
 
   // Q(lambda) and the flagged-pair distances there; the last evaluation is cached. The next
   // evaluation of another lambda reuses its storage (a reference returned before is then

@@ -152,7 +152,7 @@ struct BarrierRound {
     const VecX D_lambda = step.D() * e.lambda;
     const double unit = scale * scale * curvature;
     if (!grad.empty()) {
-      const VecX g = (2.0 * scale / unit) * (step.D().transpose() * e.MD_lambda);
+      const VecX g = step.D_transpose_times(e.MD_lambda, 2.0 * scale / unit);
       Eigen::Map<VecX>(grad.data(), g.size()) = g;
     }
     return D_lambda.dot(e.MD_lambda) / unit;

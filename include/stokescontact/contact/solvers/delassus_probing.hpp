@@ -98,7 +98,7 @@ class DelassusProbing {
     for (const std::vector<Eigen::Index>& members : colours) {
       VecX indicator = VecX::Zero(step.nc());
       for (Eigen::Index m : members) indicator(members_[static_cast<std::size_t>(m)]) = 1.0;
-      const VecX response = step.problem().dt * (step.D().transpose() * step.MD_times(indicator));
+      const VecX response = step.A_times(indicator);
       for (Eigen::Index m : members) read_rows(m, response);
     }
     probes_ += static_cast<int>(colours.size());

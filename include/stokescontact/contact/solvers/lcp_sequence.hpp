@@ -95,7 +95,7 @@ ContactSolveOutcome solve_lcp_sequence_round(ContactStep<S, M>& step, VecX lambd
       break;
     }
     ++out.iterations;
-    const VecX A_lambda = step.problem().dt * (step.D().transpose() * e.MD_lambda);
+    const VecX A_lambda = step.D_transpose_times(e.MD_lambda, step.problem().dt);
     const VecX b = e.distances - VecX::Constant(step.nc(), target) - A_lambda;
     LcpResult lcp =
         model && options.inner == InnerLcpSolver::minimum_map_newton
