@@ -8,7 +8,8 @@
 //   brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]
 //                 [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]
 //                 [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]
-//                 [--overlap-ends-angle 0.1] [--start random|aligned] [--melt 0]
+//                 [--overlap-ends-angle 0.1] [--start random|aligned|compressed] [--melt 0]
+//                 [--compress-from 0.25] [--compress-rate 5e-4] [--compress-steps 5]
 //                 [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]
 //                 [--separation-margin 1e-3] [--output FILE]
 //
@@ -17,7 +18,12 @@
 // the packing fraction of the hard core D + d_hat instead of phi (that of diameter D).
 // Start: --start random, periodic_random_placement of the seed (every gap > d_hat; phi < 0.3);
 // --start aligned, periodic_aligned_columns (every rod along z, Yan et al. Sec. IV.B's aligned
-// start, for dense suspensions), then --melt time units of Brownian motion at --melt-dt
+// start, for dense suspensions); --start compressed, an isotropic dense start: random placement
+// at the hard-core packing --compress-from (< 0.3), then the centres and the box rescaled
+// towards --eta by a factor of at least 1 - --compress-rate at a time, each rescaling followed
+// by --compress-steps Brownian steps at --melt-dt (a rescaling that would bring a pair below
+// d_hat / 2 is undone and the rate halved; it never overlaps a pair, and the steps push the
+// pairs it brought below d_hat back out); then --melt time units of Brownian motion at --melt-dt
 // without propulsion, unrecorded, whose end is the start of every run (the summary prints its
 // nematic order; --progress K writes every K-th melt step's diagnostics and the nematic order S
 // after it to stderr as JSON).
@@ -58,6 +64,7 @@
 #include <stokescontact/mobility/free_draining.hpp>
 #include <stokescontact/scenes/periodic_placement.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -67,6 +74,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/brownian_pressure.hpp"
@@ -83,7 +91,8 @@ constexpr const char* kUsage =
     "                     [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]\n"
     "                     [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]\n"
     "                     [--overlap-ends-angle 0.1]\n"
-    "                     [--start random|aligned] [--melt 0]\n"
+    "                     [--start random|aligned|compressed] [--melt 0]\n"
+    "                     [--compress-from 0.25] [--compress-rate 5e-4] [--compress-steps 5]\n"
     "                     [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]\n"
     "                     [--separation-margin 1e-3] [--output FILE]\n";
 
@@ -96,6 +105,8 @@ struct Options {
   double d_hat = 1e-2, equilibrate = 0.5, average = 2.0;
   std::string start = "random";
   double melt = 0.0, melt_dt = 1e-3;
+  double compress_from = 0.25, compress_rate = 5e-4;  // --start compressed
+  long compress_steps = 5;
   long progress = 0;  // melt steps between diagnostics lines on stderr (0: none)
   int halvings = 4;   // TimeStepperOptions::max_substep_halvings
   std::string solver = "default";
@@ -134,8 +145,17 @@ Options parse(int argc, char** argv) {
   o.separation_margin = args.number("--separation-margin", o.separation_margin, 0.0);
   if (!(o.separation_margin < 1.0)) throw std::invalid_argument("--separation-margin must lie in [0, 1)");
   o.start = args.text("--start", "random");
-  if (o.start != "random" && o.start != "aligned")
-    throw std::invalid_argument("--start must be random or aligned, got '" + o.start + "'");
+  if (o.start != "random" && o.start != "aligned" && o.start != "compressed")
+    throw std::invalid_argument("--start must be random, aligned or compressed, got '" + o.start + "'");
+  o.compress_from = args.number("--compress-from", o.compress_from, 0.0);
+  o.compress_rate = args.number("--compress-rate", o.compress_rate, 0.0);
+  o.compress_steps = static_cast<long>(args.integer("--compress-steps", o.compress_steps, 0));
+  if (o.start == "compressed") {
+    if (!o.eta) throw std::invalid_argument("--start compressed needs --eta (the packing it compresses to)");
+    if (!(o.compress_from > 0.0 && o.compress_from < *o.eta))
+      throw std::invalid_argument("--compress-from must lie in (0, --eta)");
+    if (!(o.compress_rate > 0.0 && o.compress_rate < 0.1)) throw std::invalid_argument("--compress-rate must lie in (0, 0.1)");
+  }
   o.melt = args.number("--melt", 0.0, 0.0);
   o.melt_dt = args.number("--melt-dt", 1e-3, 0.0);
   if (!(o.melt_dt > 0.0)) throw std::invalid_argument("--melt-dt must be > 0");
@@ -211,6 +231,36 @@ std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, cons
   return stepper;
 }
 
+// --start compressed (see the top): `poses` in the cube of side s.side, compressed to side
+// `to_side` in place. Prints what it took.
+void compress(const Options& o, System s, std::vector<sc::Pose>& poses, double to_side) {
+  const auto t0 = std::chrono::steady_clock::now();
+  double rate = o.compress_rate;
+  long rescalings = 0, halvings = 0;
+  while (s.side > to_side) {
+    const double factor = std::max(to_side / s.side, 1.0 - rate);
+    std::vector<sc::Pose> scaled = poses;
+    for (sc::Pose& p : scaled) p.x *= factor;
+    const sc::PeriodicBox box{sc::Vec3::Constant(s.side * factor)};
+    if (sc::minimum_pair_distance(s.rod, std::span<const sc::Pose>(scaled), box).distance < 0.5 * o.d_hat) {
+      rate *= 0.5;
+      ++halvings;
+      if (rate < 1e-12) throw std::runtime_error("--start compressed: no rescaling keeps every gap above d_hat / 2");
+      continue;
+    }
+    poses = std::move(scaled);
+    s.side *= factor;
+    ++rescalings;
+    sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);
+    const std::unique_ptr<RodStepper> stepper = make_stepper(o, s, poses, o.melt_dt, 0.0, mobility);
+    for (long k = 0; k < o.compress_steps; ++k) stepper->step();
+    poses = stepper->poses();
+  }
+  std::printf("compression: %ld rescalings (the rate halved %ld times), %ld Brownian steps, nematic order %.4f, %.1f s\n",
+              rescalings, halvings, rescalings * o.compress_steps, order_parameter(poses),
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
 int run(const Options& o) {
   constexpr double kT = 1.0, viscosity = 1.0, D = 1.0;
   const double L = o.aspect * D;
@@ -233,9 +283,19 @@ int run(const Options& o) {
   const std::optional<double> reference = virial_ratio(o.aspect, b2n);
   const std::optional<double> monte_carlo = mcgrother_z(o.aspect, eta);
   ex::JsonLines sink(o.output);
-  std::vector<sc::Pose> start = o.start == "aligned"
-                                    ? sc::periodic_aligned_columns(s.rod, o.n, s.side, o.d_hat, o.seed)
-                                    : sc::periodic_random_placement(s.rod, o.n, s.side, o.d_hat, o.seed);
+  std::vector<sc::Pose> start;
+  if (o.start == "aligned") {
+    start = sc::periodic_aligned_columns(s.rod, o.n, s.side, o.d_hat, o.seed);
+  } else if (o.start == "random") {
+    start = sc::periodic_random_placement(s.rod, o.n, s.side, o.d_hat, o.seed);
+  } else {  // compressed: placed at the hard-core packing compress_from, then compressed
+    const double phi_from = o.compress_from * rod_volume(D) / rod_volume(Dh);
+    if (!(phi_from < 0.3)) throw std::invalid_argument("--compress-from gives phi = " + std::to_string(phi_from) + ", must be < 0.3");
+    System from = s;
+    from.side = std::cbrt(static_cast<double>(o.n) * rod_volume(D) / phi_from);
+    start = sc::periodic_random_placement(s.rod, o.n, from.side, o.d_hat, o.seed);
+    compress(o, from, start, s.side);
+  }
   std::printf("Brownian rods: N = %zu spherocylinders L/D = %g in a periodic cube of side %.4g, phi %g (hard core %.4g), "
               "B2 n = %.5f,\nfree draining (Yan eq. 45-50), D_R = %.5g, equilibrate %g, average %g (1 / D_R), d_hat %g, "
               "solver %s, %s directions, start %s\n",
@@ -284,8 +344,9 @@ int run(const Options& o) {
       const bool series = reference && u0 == 0.0;
       const bool mc = monte_carlo && u0 == 0.0;
       sink.line("{\"N\": " + std::to_string(o.n) + ", \"aspect\": " + sc::json_number(o.aspect) + ", \"phi\": " +
-                sc::json_number(phi) + ", \"eta\": " + sc::json_number(eta) + ", \"start\": \"" + o.start +
-                "\", \"melt\": " + sc::json_number(o.melt) + ", \"start_nematic_order\": " +
+                sc::json_number(phi) + ", \"eta\": " + sc::json_number(eta) + ", \"start\": \"" + o.start + "\", \"compress_from\": " +
+                (o.start == "compressed" ? sc::json_number(o.compress_from) : std::string("null")) +
+                ", \"melt\": " + sc::json_number(o.melt) + ", \"start_nematic_order\": " +
                 sc::json_number(start_order) + ", \"u0_over_L_DR\": " + sc::json_number(u0_scaled) +
                 ", \"u0\": " + sc::json_number(u0) + ", \"D_R\": " + sc::json_number(s.D_R) + ", \"dt_D_R\": " +
                 sc::json_number(dt_D_R) + ", \"d_hat\": " + sc::json_number(o.d_hat) + ", \"solver\": \"" +
