@@ -1,0 +1,55 @@
+#!/usr/bin/python3
+"""The nematic order parameter S against time from brownian_rods --progress logs (stderr
+lines "melt {...}" with "nematic_order"), one curve per log.
+
+usage: scripts/plot_nematic_order.py OUT.png DT_D_R LABEL=LOG [LABEL=LOG ...]
+
+DT_D_R: the melt's step in rotational times (--melt-dt); time is step x DT_D_R. Prints per
+log: the steps logged, the last time, S at the start and the end, and the mean and spread of S
+over the last quarter of the logged time.
+"""
+import json
+import statistics
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def order_of(path):
+    with open(path) as f:
+        steps = [json.loads(line[len("melt "):]) for line in f if line.startswith("melt {")]
+    if not steps or "nematic_order" not in steps[0]:
+        sys.exit(f"{path}: no melt lines with nematic_order (run brownian_rods with --progress K)")
+    return [s["step"] for s in steps], [s["nematic_order"] for s in steps]
+
+
+def main():
+    if len(sys.argv) < 4 or any("=" not in a for a in sys.argv[3:]):
+        sys.exit(__doc__)
+    out, dt = sys.argv[1], float(sys.argv[2])
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    print("| run | steps logged | last t D_R | S at the first line | S at the last | S over the last quarter (mean +- sd) |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    for spec in sys.argv[3:]:
+        label, path = spec.split("=", 1)
+        steps, order = order_of(path)
+        t = [s * dt for s in steps]
+        tail = [s for ts, s in zip(t, order) if ts >= 0.75 * t[-1]]
+        spread = statistics.stdev(tail) if len(tail) > 1 else 0.0
+        print(f"| {label} | {steps[-1]} | {t[-1]:.2f} | {order[0]:.3f} | {order[-1]:.3f} | "
+              f"{statistics.mean(tail):.3f} +- {spread:.3f} |")
+        ax.plot(t, order, label=label)
+    ax.set_xlabel("t D_R")
+    ax.set_ylabel("nematic order S")
+    ax.set_ylim(0.0, 1.0)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+
+
+if __name__ == "__main__":
+    main()
