@@ -42,8 +42,8 @@ inline void sparse_transpose_times(const Eigen::SparseMatrix<double>& S, const V
   const Eigen::Index chunks = (n + kSparseTransposeChunk - 1) / kSparseTransposeChunk;
   parallel_for(
       chunks,
-      [&](std::ptrdiff_t c) {
-        const Eigen::Index begin = c * kSparseTransposeChunk;
+      [&](std::ptrdiff_t chunk) {
+        const Eigen::Index begin = chunk * kSparseTransposeChunk;
         columns(begin, std::min(n, begin + kSparseTransposeChunk));
       },
       2);
