@@ -13,6 +13,10 @@
 // solver a converged step turning a rod by more than 0.3 rad; these two are among the clearest
 // (the second case of this file's first version, theta 0.251, converges at a near root since
 // the working-set LCP starts from BBPGD).
+// These far roots are those of the model at Q* (the default solver's in formed and
+// matrix-free modes): the tests pin them with DefectCorrectionOptions::jacobian_at_iterate
+// off. With the Jacobian at the iterate (blocks mode's default) the default solver converges
+// at the near root of the second case itself, and the guard still refuses the first.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -85,14 +89,26 @@ struct CrossingStep {
   sc::ContactStepProblem<sc::Spherocylinder> problem() const { return {shapes, q, U, kDt, kDHat, 0.0, 1.0, {}}; }
 };
 
+// The default solver with the model at Q* and its secants, as in formed and matrix-free mode.
+sc::DefectCorrectionOptions model_at_trial() {
+  sc::DefectCorrectionOptions o;
+  o.jacobian_at_iterate = false;
+  return o;
+}
+
+sc::DefectCorrectionOptions model_at_trial_without_fallback() {
+  sc::DefectCorrectionOptions o = model_at_trial();
+  o.far_root_fallback = false;
+  o.lcp_sequence_fallback = false;
+  return o;
+}
+
 }  // namespace
 
 // The far root is found, and reported as failed separation naming the option; the same step
 // with the guard lifted is the old "converged" answer, which the test shows is a far root.
 TEST(CrossingRods, FarRootIsNotReportedConverged) {
-  sc::DefectCorrectionOptions without_fallback;
-  without_fallback.far_root_fallback = false;
-  without_fallback.lcp_sequence_fallback = false;
+  const sc::DefectCorrectionOptions without_fallback = model_at_trial_without_fallback();
   for (const Crossing& c : kCrossings) {
     SCOPED_TRACE("theta " + std::to_string(c.theta));
     CrossingStep setup(c);
@@ -113,7 +129,7 @@ TEST(CrossingRods, FarRootIsNotReportedConverged) {
     // pair ends more than 10 d_hat apart, pushed by 7-10x the force that pressed it.
     sc::ContactStepOptions unguarded;
     unguarded.max_correction_turn = 1e9;
-    const sc::ContactStepResult far = sc::solve_contact_step(problem, mobility, unguarded);
+    const sc::ContactStepResult far = sc::solve_contact_step(problem, mobility, unguarded, sc::ContactSolver{model_at_trial()});
     EXPECT_EQ(far.status, sc::ContactStepStatus::converged) << far.message;
     EXPECT_GT(far.min_distance_ratio, 10.0);
     EXPECT_GT(far.max_correction_turn, 1.0);
@@ -138,7 +154,7 @@ TEST(CrossingRods, DefaultSolverFallsBackToTheNearRoot) {
     EXPECT_LT(near.lambda_max, 3.0 * c.push);
     EXPECT_GE(near.min_distance_ratio, 1.0 - 1e-3);
 
-    const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility);
+    const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, {}, sc::ContactSolver{model_at_trial()});
     EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
     EXPECT_EQ(r.fallback, "barrier-working-set");
     EXPECT_NE(r.message.find("barrier-working-set"), std::string::npos) << r.message;
@@ -150,7 +166,8 @@ TEST(CrossingRods, DefaultSolverFallsBackToTheNearRoot) {
     sc::TimeStepperOptions o;
     o.dt = kDt;
     o.d_hat = kDHat;
-    sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({kRod}, setup.q, mobility, o);
+    sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({kRod}, setup.q, mobility,
+                                                                        sc::ContactSolver{model_at_trial()}, o);
     stepper.set_external_forces(forces(c));
     const sc::StepDiagnostics d = stepper.step();
     EXPECT_EQ(d.status, sc::ContactStepStatus::converged) << d.message;
@@ -166,7 +183,7 @@ TEST(CrossingRods, FarRootFallbackSkipsStepsWithMorePairsThanItsBound) {
   const Crossing& c = kCrossings[0];
   CrossingStep setup(c);
   const auto problem = setup.problem();
-  sc::DefectCorrectionOptions bounded;
+  sc::DefectCorrectionOptions bounded = model_at_trial();
   const sc::ContactStepResult first = sc::solve_contact_step(problem, setup.mobility, {}, bounded);
   ASSERT_EQ(first.fallback, "barrier-working-set");
   bounded.far_root_fallback_max_pairs = first.flagged_pairs - 1;
@@ -174,6 +191,29 @@ TEST(CrossingRods, FarRootFallbackSkipsStepsWithMorePairsThanItsBound) {
   EXPECT_NE(r.fallback, "barrier-working-set");
   EXPECT_EQ(r.message.find("barrier-working-set"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("lcp-newton"), std::string::npos) << r.message;
+}
+
+// With the Jacobian at the iterate (the default in blocks mode) the default solver converges
+// at the second case's near root by itself, no fallback: the barrier's answer within the
+// solvers' tolerances. The first case's iterates still head for a far root: the guard refuses
+// it and the fallback gives the near root, as above.
+TEST(CrossingRods, JacobianAtTheIterateConvergesAtTheNearRoot) {
+  for (std::size_t k = 0; k < kCrossings.size(); ++k) {
+    const Crossing& c = kCrossings[k];
+    SCOPED_TRACE("theta " + std::to_string(c.theta));
+    CrossingStep setup(c);
+    const auto problem = setup.problem();
+    const sc::ContactStepResult near =
+        sc::solve_contact_step(problem, setup.mobility, {}, sc::contact_solver_from_name("barrier-working-set"));
+    const sc::ContactStepResult r = sc::solve_contact_step(problem, setup.mobility);
+    EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+    EXPECT_LT(r.max_correction_turn, 0.5);
+    EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+    EXPECT_LT(r.lambda_max, 3.0 * c.push);
+    ASSERT_EQ(r.lambda.size(), near.lambda.size());
+    EXPECT_LE((r.lambda - near.lambda).lpNorm<Eigen::Infinity>(), 1e-3 * near.lambda_max);
+    EXPECT_EQ(r.fallback, k == 1 ? "" : "barrier-working-set") << r.message;
+  }
 }
 #endif
 
@@ -186,9 +226,7 @@ TEST(CrossingRods, StepperSubStepsTheRefusedStep) {
     sc::TimeStepperOptions o;
     o.dt = kDt;
     o.d_hat = kDHat;
-    sc::DefectCorrectionOptions without_fallback;
-    without_fallback.far_root_fallback = false;
-    without_fallback.lcp_sequence_fallback = false;
+    const sc::DefectCorrectionOptions without_fallback = model_at_trial_without_fallback();
     sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility> stepper({kRod}, poses(c), mobility,
                                                                         sc::ContactSolver{without_fallback}, o);
     stepper.set_external_forces(forces(c));

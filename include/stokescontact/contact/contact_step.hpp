@@ -627,14 +627,21 @@ class ContactStep {
   // The contact matrix of the flagged pairs at an evaluated configuration: D_k, with
   // D_k^T U = the rate of change of their distances there.
   Eigen::SparseMatrix<double> contact_matrix_at(const ContactEvaluation& e) const {
+    std::vector<Eigen::Index> all(pairs_.size());
+    for (std::size_t k = 0; k < all.size(); ++k) all[k] = static_cast<Eigen::Index>(k);
+    return contact_matrix_at(e, all);
+  }
+  // Its columns of the flagged pairs `which` only (indices into pairs(), in that order).
+  Eigen::SparseMatrix<double> contact_matrix_at(const ContactEvaluation& e, std::span<const Eigen::Index> which) const {
     const VecX V = problem_.U + e.MD_lambda;
-    std::vector<ContactColumn> columns;
-    columns.reserve(pairs_.size());
-    for (std::size_t k = 0; k < pairs_.size(); ++k)
-      columns.push_back(carried_[k] && carried_[k]->interior
-                            ? interior_column(*carried_[k], e.pairs[k], V)
-                            : detail::particle_contact_column(e.pairs[k], std::span<const Pose>(e.poses),
-                                                              "pairs[" + std::to_string(k) + "]"));
+    std::vector<ContactColumn> columns(which.size());
+    parallel_for(static_cast<std::ptrdiff_t>(which.size()), [&](std::ptrdiff_t c) {
+      const auto k = static_cast<std::size_t>(which[static_cast<std::size_t>(c)]);
+      columns[static_cast<std::size_t>(c)] =
+          carried_[k] && carried_[k]->interior
+              ? interior_column(*carried_[k], e.pairs[k], V)
+              : detail::particle_contact_column(e.pairs[k], std::span<const Pose>(e.poses), "pairs[" + std::to_string(k) + "]");
+    });
     return assemble_contact_matrix(columns, e.poses.size(), dofs_);
   }
 
