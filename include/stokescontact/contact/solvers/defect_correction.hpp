@@ -44,10 +44,11 @@
 //    correction on is the Jacobian of the distances at the iterate, dt D_k^T M D, D_k the
 //    contact matrix at Q(lambda_k) (DefectCorrectionOptions::jacobian_at_iterate; Lu et al.
 //    re-linearise each LCP at the current configuration the same way): Newton's method on
-//    eq. 27, not a chord method. Dense Brownian rods (400, L/D = 5, eta 0.40-0.45): 26-34
-//    corrections per step instead of 68-110, 1.5-1.9x less time; jammed spheres: 4 instead of
-//    8-10, the same time. Two corrections in a row that contract neither the shortfall nor
-//    the change of lambda hand the round back to the model at Q* with secants.
+//    eq. 27, not a chord method. Dense Brownian rods (400, L/D = 5, eta 0.31-0.45): 14-59
+//    corrections per step instead of 20-110, a 1.2-1.4x shorter median step; jammed spheres:
+//    4 instead of 8-10, about the same time (docs/results.md, "The Jacobian at the iterate").
+//    Two corrections in a row that contract neither the shortfall nor the change of lambda
+//    hand the round back to the model at Q* with secants.
 //
 //  - the distance need not grow monotonically along the force (non-convex shapes: interlocked
 //    boomerangs, whose closest points jump between arms as the bodies turn), so a converged
@@ -143,6 +144,14 @@ struct DefectCorrectionOptions {
   // correction").
   bool early_end_check = true;
   std::size_t early_end_check_min_pushed = 1000;
+  // Blocks mode (M D sparse and exact), convex shapes, contact directions from closest
+  // points: the model of each correction from a nonzero iterate is the Jacobian of the
+  // distances there, dt D_k^T M D on the working set (D_k the contact matrix at Q(lambda_k),
+  // ContactStep::contact_matrix_at), as Lu et al. linearise each LCP of their sequence at the
+  // current configuration: Newton's method on Broms eq. 27 instead of a chord method with
+  // the Jacobian at Q*, which needs many corrections where bodies turn or slide far along
+  // each other. false: the model at Q*, corrected by secants (the other modes always).
+  bool jacobian_at_iterate = true;
   // A step this solver fails is solved again through solve_contact_step (contact_solver.hpp,
   // solve_failed_step_again), the first answer that does not fail kept: a far root (its
   // correction turns a body by more than ContactStepOptions::max_correction_turn) by eq. 15
@@ -153,14 +162,6 @@ struct DefectCorrectionOptions {
   // on steps of at most far_root_fallback_max_pairs flagged pairs: on 400 aligned L/D = 5
   // rods at packing 0.31 (1300 flagged pairs, docs/results.md "Dense Brownian rods") one such
   // solve was still running 40 s into its step.
-  // Blocks mode (M D sparse and exact), contact directions from closest points: each
-  // correction's model is the Jacobian of the distances at the iterate, dt D_k^T M D on the
-  // working set (D_k the contact matrix at Q(lambda_k), ContactStep::contact_matrix_at), as
-  // Lu et al. linearise each LCP of their sequence at the current configuration (Sec. 3.2):
-  // Newton's method on Broms eq. 27 instead of a chord method with the Jacobian at Q*, which
-  // needs many corrections where bodies turn or slide far along each other. false: the model
-  // at Q*, corrected by secants (the other modes always).
-  bool jacobian_at_iterate = true;
   bool far_root_fallback = true;
   bool lcp_sequence_fallback = true;
   std::size_t far_root_fallback_max_pairs = 256;
