@@ -23,7 +23,6 @@
 #include "stokescontact/mobility/free_draining.hpp"
 #include "stokescontact/scenes/periodic_placement.hpp"
 #include "stokescontact/scenes/random.hpp"
-#include "stokescontact/scenes/sphere_packing.hpp"
 
 namespace iterate_jacobian_tests {
 
