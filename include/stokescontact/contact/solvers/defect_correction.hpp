@@ -45,8 +45,10 @@
 //    contact matrix at Q(lambda_k) (DefectCorrectionOptions::jacobian_at_iterate; Lu et al.
 //    re-linearise each LCP at the current configuration the same way): Newton's method on
 //    eq. 27, not a chord method. Dense Brownian rods (400, L/D = 5, eta 0.31-0.45): 14-59
-//    corrections per step instead of 20-110, a 1.2-1.4x shorter median step; jammed spheres:
-//    4 instead of 8-10, about the same time (docs/results.md, "The Jacobian at the iterate").
+//    corrections per step instead of 20-110, a 1.2-1.4x shorter median step, but its
+//    sub-stepped steps cost 1.8x more (1424 steps at eta 0.40: 1.15x longer in all); jammed
+//    spheres: 4 instead of 8-10, about the same time (docs/results.md, "The Jacobian at the
+//    iterate").
 //    Two corrections in a row that contract neither the shortfall nor the change of lambda
 //    hand the round back to the model at Q* with secants.
 //
