@@ -11,7 +11,8 @@
 //                 [--overlap-ends-angle 0.1] [--start random|aligned|compressed] [--melt 0]
 //                 [--compress-from 0.25] [--compress-rate 5e-4] [--compress-steps 5]
 //                 [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]
-//                 [--separation-margin 1e-3] [--output FILE]
+//                 [--separation-margin 1e-3] [--save-state FILE] [--save-every 1000]
+//                 [--load-state FILE] [--output FILE]
 //
 // --u0 is given as U0 / (L D_R), the paper's Fig. 6 axis (D_R = kT / zeta_r, eq. 49); --dt,
 // --equilibrate, --average, --melt and --melt-dt are in rotational times 1 / D_R. --eta gives
@@ -27,6 +28,13 @@
 // without propulsion, unrecorded, whose end is the start of every run (the summary prints its
 // nematic order; --progress K writes every K-th melt step's diagnostics and the nematic order S
 // after it to stderr as JSON).
+// Continuing a run (io/checkpoint.hpp): --save-state FILE writes the melt's state (time, box,
+// poses, the Brownian stream) every --save-every melt steps and at the melt's end (without a
+// melt: the start); --load-state FILE starts from such a file instead of --start (same --n,
+// --aspect and packing: the box must match), and its melt goes on with the saved stream, so
+// `--melt 2 --save-state s` then `--load-state s --melt 3` takes the same steps as `--melt 5`.
+// One Brownian stream runs through the whole program (the compression's steppers, the melt,
+// then each measured run from the melt's end): no phase draws the seed's first variates again.
 // Every (U0, dt) runs from that start; given several --dt, a row "dt -> 0" per U0
 // extrapolates Z = Z_0 + c sqrt(dt) (brownian_pressure.hpp). --directions: the contact
 // directions (overlap-ends holds near-parallel rods at both ends of their overlap, when it is
@@ -58,6 +66,7 @@
 // bars of that series.
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
 #include <stokescontact/dynamics/nematic_order.hpp>
+#include <stokescontact/io/checkpoint.hpp>
 #include <stokescontact/dynamics/time_stepper.hpp>
 #include <stokescontact/io/diagnostics_json.hpp>
 #include <stokescontact/io/json.hpp>
@@ -94,7 +103,8 @@ constexpr const char* kUsage =
     "                     [--start random|aligned|compressed] [--melt 0]\n"
     "                     [--compress-from 0.25] [--compress-rate 5e-4] [--compress-steps 5]\n"
     "                     [--melt-dt 1e-3] [--progress 0] [--max-substep-halvings 4] [--tolerance 0]\n"
-    "                     [--separation-margin 1e-3] [--output FILE]\n";
+    "                     [--separation-margin 1e-3] [--save-state FILE] [--save-every 1000]\n"
+    "                     [--load-state FILE] [--output FILE]\n";
 
 struct Options {
   double aspect = 5.0;
@@ -116,6 +126,8 @@ struct Options {
   double separation_margin = sc::ContactStepOptions{}.separation_margin;
   std::uint64_t seed = 1;
   double tolerance = 0.0;
+  std::string save_state, load_state;  // checkpoint files (empty: none)
+  long save_every = 1000;              // melt steps between checkpoints
   std::string output;
 };
 
@@ -144,9 +156,15 @@ Options parse(int argc, char** argv) {
   o.ends_angle = args.number("--overlap-ends-angle", o.ends_angle, 1e-12);
   o.separation_margin = args.number("--separation-margin", o.separation_margin, 0.0);
   if (!(o.separation_margin < 1.0)) throw std::invalid_argument("--separation-margin must lie in [0, 1)");
+  o.load_state = args.text("--load-state", "");
+  if (!o.load_state.empty() && args.text("--start", "") != "")
+    throw std::invalid_argument("give --start or --load-state, not both");
+  o.save_state = args.text("--save-state", "");
+  o.save_every = static_cast<long>(args.integer("--save-every", o.save_every, 1));
   o.start = args.text("--start", "random");
   if (o.start != "random" && o.start != "aligned" && o.start != "compressed")
     throw std::invalid_argument("--start must be random, aligned or compressed, got '" + o.start + "'");
+  if (!o.load_state.empty()) o.start = "checkpoint";
   o.compress_from = args.number("--compress-from", o.compress_from, 0.0);
   o.compress_rate = args.number("--compress-rate", o.compress_rate, 0.0);
   o.compress_steps = static_cast<long>(args.integer("--compress-steps", o.compress_steps, 0));
@@ -204,9 +222,11 @@ struct System {
 
 using RodStepper = sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility>;
 
-// A Brownian stepper from `start` at step dt_D_R / D_R, each rod propelled at u0 along its axis.
+// A Brownian stepper from `start` at time t0 with step dt_D_R / D_R, drawing from `noise` on
+// (the program's one stream), each rod propelled at u0 along its axis.
 std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, const std::vector<sc::Pose>& start,
-                                         double dt_D_R, double u0, sc::FreeDrainingMobility& mobility) {
+                                         double dt_D_R, double u0, sc::FreeDrainingMobility& mobility,
+                                         const sc::GaussianStream& noise, double t0 = 0.0) {
   sc::TimeStepperOptions options;
   options.dt = dt_D_R / s.D_R;
   options.d_hat = o.d_hat;
@@ -220,7 +240,8 @@ std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, cons
   options.brownian->kT = 1.0;
   options.brownian->seed = o.seed;
   auto stepper = std::make_unique<RodStepper>(std::vector<sc::Spherocylinder>{s.rod}, start, mobility,
-                                              sc::contact_solver_from_name(o.solver), options);
+                                              sc::contact_solver_from_name(o.solver), options, t0);
+  stepper->set_noise(noise);
   if (u0 > 0.0)  // self-propulsion: M F = U0 n for the force U0 zeta_par n (no torque)
     stepper->set_external_force_field([u0, m_par = s.m_par](double, std::span<const sc::Pose> poses) {
       sc::VecX F = sc::VecX::Zero(6 * static_cast<Eigen::Index>(poses.size()));
@@ -232,8 +253,8 @@ std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, cons
 }
 
 // --start compressed (see the top): `poses` in the cube of side s.side, compressed to side
-// `to_side` in place. Prints what it took.
-void compress(const Options& o, System s, std::vector<sc::Pose>& poses, double to_side) {
+// `to_side` in place, its steps drawing from `noise` on. Prints what it took.
+void compress(const Options& o, System s, std::vector<sc::Pose>& poses, double to_side, sc::GaussianStream& noise) {
   const auto t0 = std::chrono::steady_clock::now();
   double rate = o.compress_rate;
   long rescalings = 0, halvings = 0;
@@ -252,9 +273,10 @@ void compress(const Options& o, System s, std::vector<sc::Pose>& poses, double t
     s.side *= factor;
     ++rescalings;
     sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);
-    const std::unique_ptr<RodStepper> stepper = make_stepper(o, s, poses, o.melt_dt, 0.0, mobility);
+    const std::unique_ptr<RodStepper> stepper = make_stepper(o, s, poses, o.melt_dt, 0.0, mobility, noise);
     for (long k = 0; k < o.compress_steps; ++k) stepper->step();
     poses = stepper->poses();
+    noise = stepper->noise();
   }
   std::printf("compression: %ld rescalings (the rate halved %ld times), %ld Brownian steps, nematic order %.4f, %.1f s\n",
               rescalings, halvings, rescalings * o.compress_steps, order_parameter(poses),
@@ -284,7 +306,21 @@ int run(const Options& o) {
   const std::optional<double> monte_carlo = mcgrother_z(o.aspect, eta);
   ex::JsonLines sink(o.output);
   std::vector<sc::Pose> start;
-  if (o.start == "aligned") {
+  sc::GaussianStream noise(o.seed);
+  double start_time = 0.0;
+  if (o.start == "checkpoint") {
+    const sc::Checkpoint c = sc::load_checkpoint(o.load_state);
+    if (c.poses.size() != o.n)
+      throw std::invalid_argument("--load-state " + o.load_state + " holds " + std::to_string(c.poses.size()) +
+                                  " rods, --n is " + std::to_string(o.n));
+    if (!c.box || (c.box->lengths.array() - s.side).abs().maxCoeff() > 1e-12 * s.side)
+      throw std::invalid_argument("--load-state " + o.load_state + ": its box is not the cube of side " +
+                                  std::to_string(s.side) + " that --n and the packing give");
+    if (!c.noise) throw std::invalid_argument("--load-state " + o.load_state + " holds no Brownian stream");
+    start = c.poses;
+    noise = *c.noise;
+    start_time = c.time;
+  } else if (o.start == "aligned") {
     start = sc::periodic_aligned_columns(s.rod, o.n, s.side, o.d_hat, o.seed);
   } else if (o.start == "random") {
     start = sc::periodic_random_placement(s.rod, o.n, s.side, o.d_hat, o.seed);
@@ -294,7 +330,7 @@ int run(const Options& o) {
     System from = s;
     from.side = std::cbrt(static_cast<double>(o.n) * rod_volume(D) / phi_from);
     start = sc::periodic_random_placement(s.rod, o.n, from.side, o.d_hat, o.seed);
-    compress(o, from, start, s.side);
+    compress(o, from, start, s.side, noise);
   }
   std::printf("Brownian rods: N = %zu spherocylinders L/D = %g in a periodic cube of side %.4g, phi %g (hard core %.4g), "
               "B2 n = %.5f,\nfree draining (Yan eq. 45-50), D_R = %.5g, equilibrate %g, average %g (1 / D_R), d_hat %g, "
@@ -302,9 +338,13 @@ int run(const Options& o) {
               o.n, o.aspect, s.side, phi, eta, b2n, s.D_R, o.equilibrate, o.average, o.d_hat, o.solver.c_str(),
               ex::directions_name(o.directions), o.start.c_str());
   double start_order = order_parameter(start);
+  const auto save_state = [&](const std::vector<sc::Pose>& poses, const sc::GaussianStream& stream, double time) {
+    if (!o.save_state.empty())
+      sc::save_checkpoint(o.save_state, sc::Checkpoint{time, sc::PeriodicBox{sc::Vec3::Constant(s.side)}, poses, stream});
+  };
   if (o.melt > 0.0) {
     sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);
-    const std::unique_ptr<RodStepper> melter = make_stepper(o, s, start, o.melt_dt, 0.0, mobility);
+    const std::unique_ptr<RodStepper> melter = make_stepper(o, s, start, o.melt_dt, 0.0, mobility, noise, start_time);
     const long steps = std::lround(o.melt / o.melt_dt);
     const auto t0 = std::chrono::steady_clock::now();
     for (long k = 0; k < steps; ++k) {
@@ -312,13 +352,16 @@ int run(const Options& o) {
       if (o.progress > 0 && (k + 1) % o.progress == 0)  // the step's diagnostics and the order it leaves
         std::fprintf(stderr, "melt {\"nematic_order\": %s, %s\n", sc::json_number(order_parameter(melter->poses())).c_str(),
                      sc::to_json(d).c_str() + 1);
+      if ((k + 1) % o.save_every == 0 || k + 1 == steps) save_state(melter->poses(), melter->noise(), melter->time());
     }
     start = melter->poses();
-    std::printf("melt: %ld steps at dt %g / D_R, nematic order %.4f -> %.4f, %.1f s\n", steps, o.melt_dt,
-                start_order, order_parameter(start),
+    noise = melter->noise();
+    std::printf("melt: %ld steps at dt %g / D_R, nematic order %.4f -> %.4f, t D_R %.6g -> %.6g, %.1f s\n", steps,
+                o.melt_dt, start_order, order_parameter(start), start_time * s.D_R, melter->time() * s.D_R,
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     start_order = order_parameter(start);
   }
+  if (!(o.melt > 0.0)) save_state(start, noise, start_time);
   if (monte_carlo) std::printf("McGrother et al. 1996 (Monte Carlo, isotropic) at eta %.3f: Z = %.4f\n", eta, *monte_carlo);
   std::printf("%9s %8s | %8s %8s | %8s %8s | %9s | %7s %6s %6s | %9s | %7s | %8s\n", "U0/(L DR)", "dt D_R", "ratio",
               "+-", "Z", "+-", "series", "pushed", "apps", "its", "min d/dh", "S", "wall s");
@@ -328,7 +371,7 @@ int run(const Options& o) {
     std::vector<ex::ZAtStep> measured_z;
     for (const double dt_D_R : o.dts) {
       sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);
-      const std::unique_ptr<RodStepper> stepper = make_stepper(o, s, start, dt_D_R, u0, mobility);
+      const std::unique_ptr<RodStepper> stepper = make_stepper(o, s, start, dt_D_R, u0, mobility, noise);
       const ex::BrownianPressureRun r =
           ex::measure_brownian_pressure(*stepper, kT, std::lround(o.equilibrate / dt_D_R),
                                         std::max(2L, std::lround(o.average / dt_D_R)), order_parameter);

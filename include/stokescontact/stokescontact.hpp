@@ -86,6 +86,7 @@
 
 // io
 #include "stokescontact/io/body_mesh.hpp"
+#include "stokescontact/io/checkpoint.hpp"
 #include "stokescontact/io/diagnostics_json.hpp"
 #include "stokescontact/io/json.hpp"
 #include "stokescontact/io/vtk_polydata.hpp"

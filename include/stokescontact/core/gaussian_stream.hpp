@@ -13,6 +13,9 @@
 // seed would give different trajectories under libstdc++, libc++ and MSVC.
 #include <cmath>
 #include <cstdint>
+#include <ios>
+#include <istream>
+#include <ostream>
 #include <random>
 
 #include "stokescontact/core/types.hpp"
@@ -50,6 +53,38 @@ class GaussianStream {
 
   // The seed the stream started from (for reports and failure messages).
   std::uint64_t seed() const { return seed_; }
+
+  // Two streams in the same state draw the same variates from here on.
+  bool operator==(const GaussianStream&) const = default;
+
+  // The whole state as text: the seed, the kept variate of the last pair, and the engine's
+  // state (its standard text form, 312 words and the position in them). A stream read back
+  // draws exactly what this one would draw next (io/checkpoint.hpp: a run continued later).
+  friend std::ostream& operator<<(std::ostream& out, const GaussianStream& g) {
+    const std::ios_base::fmtflags flags = out.flags();
+    const std::streamsize precision = out.precision();
+    out << std::dec << g.seed_ << ' ' << (g.has_spare_ ? 1 : 0) << ' ';
+    out.precision(17);  // round trip of the double
+    out << std::defaultfloat << g.spare_ << ' ' << g.engine_;
+    out.flags(flags);
+    out.precision(precision);
+    return out;
+  }
+
+  // Reads what operator<< wrote; on malformed text the stream's failbit is set and `g` is
+  // left as it was.
+  friend std::istream& operator>>(std::istream& in, GaussianStream& g) {
+    GaussianStream read(0);
+    int has_spare = -1;
+    in >> read.seed_ >> has_spare >> read.spare_ >> read.engine_;
+    if (!in || (has_spare != 0 && has_spare != 1)) {
+      in.setstate(std::ios_base::failbit);
+      return in;
+    }
+    read.has_spare_ = has_spare == 1;
+    g = read;
+    return in;
+  }
 
  private:
   // Uniform in [0, 1) from the top 53 bits: every double of the form k 2^-53.

@@ -223,6 +223,13 @@ class TimeStepper {
     for (int k = 0; k < steps; ++k) step();
   }
 
+  // The Gaussian stream in its present state (it starts from options.brownian->seed). A
+  // stepper given it by set_noise draws, from its next step on, what this one would: a run
+  // continued by another stepper (another dt, a restart from io/checkpoint.hpp) goes on with
+  // the same stream instead of drawing the seed's first variates again.
+  const GaussianStream& noise() const { return noise_; }
+  void set_noise(GaussianStream noise) { noise_ = std::move(noise); }
+
   const std::vector<Pose>& poses() const { return poses_; }
   const std::vector<S>& shapes() const { return shapes_; }
   double time() const { return time_; }
