@@ -56,6 +56,18 @@ TEST(RigidMotion, AdvanceIsFirstOrderConsistentWithPsi) {
   EXPECT_LT(((next.q.vec() - pose.q.vec()) / dt - rate.tail<3>()).norm(), 1e-6);
 }
 
+// Without rotation (omega = 0 exactly, e.g. a sphere model with 3 dofs per body) the
+// orientation is kept bit for bit; a tiny nonzero rotation takes the general path, still unit.
+TEST(RigidMotion, AdvanceWithoutRotationKeepsTheOrientation) {
+  const sc::Pose pose{sc::Vec3(1, 2, 3), sc::Quat(Eigen::AngleAxisd(0.4, sc::Vec3(1, 2, 2).normalized()))};
+  const sc::Pose next = sc::advance(pose, sc::Vec3(0.5, 0, 0), sc::Vec3::Zero(), 0.1);
+  EXPECT_EQ(next.q.coeffs(), pose.q.coeffs());
+  EXPECT_EQ(next.x, sc::Vec3(1.05, 2, 3));
+  const sc::Pose turned = sc::advance(pose, sc::Vec3::Zero(), sc::Vec3(0, 0, 1e-300), 1.0);
+  EXPECT_NEAR(turned.q.angularDistance(pose.q), 0.0, 1e-15);
+  EXPECT_NEAR(turned.q.norm(), 1.0, 1e-15);
+}
+
 TEST(RigidMotion, ConstantRotationIsExactOverManySteps) {
   const sc::Vec3 omega = sc::Vec3(0.3, -0.2, 1.0);
   const double dt = 1e-3;

@@ -41,7 +41,8 @@ inline Quat quaternion_exp(const Vec3& half_rotation) {
 }
 
 // One step of the rigid motion with constant (u, omega) over dt: the exact rotation by
-// omega dt, renormalised so that rounding never accumulates into |q| != 1.
+// omega dt, renormalised so that rounding never accumulates into |q| != 1. With omega = 0
+// exactly (every body of a model without rotations, dofs_per_body 3) q is kept as it is.
 inline Pose advance(const Pose& pose, const Vec3& u, const Vec3& omega, double dt) {
   validate(pose);
   require_finite(u, "u");
@@ -49,6 +50,10 @@ inline Pose advance(const Pose& pose, const Vec3& u, const Vec3& omega, double d
   require_finite(dt, "dt");
   Pose next;
   next.x = pose.x + dt * u;
+  if (omega.isZero(0.0)) {
+    next.q = pose.q;
+    return next;
+  }
   next.q = quaternion_exp(0.5 * dt * omega) * pose.q;
   next.q.normalize();
   return next;

@@ -33,6 +33,7 @@
 #include <Eigen/SparseCore>
 
 #include "stokescontact/core/errors.hpp"
+#include "stokescontact/core/parallel_for.hpp"
 #include "stokescontact/core/pose.hpp"
 #include "stokescontact/geometry/shapes.hpp"
 #include "stokescontact/mobility/mobility_operator.hpp"
@@ -185,16 +186,32 @@ class FreeDrainingMobility {
   // The same matrix, sparse: dofs^2 entries per body (BlockDiagonalMobility, 0 applications).
   Eigen::SparseMatrix<double> block_diagonal() const {
     require_configured();
+    // Written straight into compressed storage, column by column (each body's columns hold
+    // only its own block's nonzeros): two passes, counting then filling (each forms the
+    // blocks again: no N blocks held); no insertions.
     const auto n = static_cast<Eigen::Index>(shape_of_body_.size());
-    Eigen::SparseMatrix<double> m(size(), size());
-    m.reserve(Eigen::VectorXi::Constant(size(), dofs_));
-    for (Eigen::Index i = 0; i < n; ++i) {
+    std::vector<int> counts(static_cast<std::size_t>(size()));
+    parallel_for(n, [&](std::ptrdiff_t i) {
       const Mat6 b = block(i);
       for (int c = 0; c < dofs_; ++c)
+        counts[static_cast<std::size_t>(dofs_ * i + c)] = static_cast<int>((b.col(c).head(dofs_).array() != 0.0).count());
+    });
+    Eigen::SparseMatrix<double> m(size(), size());
+    int* outer = m.outerIndexPtr();
+    outer[0] = 0;
+    for (Eigen::Index c = 0; c < size(); ++c) outer[c + 1] = outer[c] + counts[static_cast<std::size_t>(c)];
+    m.resizeNonZeros(outer[size()]);
+    parallel_for(n, [&](std::ptrdiff_t i) {
+      const Mat6 b = block(i);
+      for (int c = 0; c < dofs_; ++c) {
+        int k = outer[dofs_ * i + c];
         for (int r = 0; r < dofs_; ++r)
-          if (b(r, c) != 0.0) m.insert(dofs_ * i + r, dofs_ * i + c) = b(r, c);
-    }
-    m.makeCompressed();
+          if (b(r, c) != 0.0) {
+            m.innerIndexPtr()[k] = static_cast<int>(dofs_ * i + r);
+            m.valuePtr()[k++] = b(r, c);
+          }
+      }
+    });
     return m;
   }
 
