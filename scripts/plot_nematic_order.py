@@ -2,9 +2,11 @@
 """The nematic order parameter S against time from brownian_rods --progress logs (stderr
 lines "melt {...}" with "nematic_order"), one curve per log.
 
-usage: scripts/plot_nematic_order.py OUT.png DT_D_R LABEL=LOG [LABEL=LOG ...]
+usage: scripts/plot_nematic_order.py OUT.png DT_D_R LABEL=LOG[,LOG...] [LABEL=LOG[,LOG...] ...]
 
-DT_D_R: the melt's step in rotational times (--melt-dt); time is step x DT_D_R. Prints per
+DT_D_R: the melt's step in rotational times (--melt-dt); time is step x DT_D_R. Several logs
+of one label are one run continued (brownian_rods --load-state): each log's steps count on
+from the previous log's last logged step (so --progress must divide the melt's steps). Prints per
 log: the steps logged, the last time, S at the start and the end, and the mean and spread of S
 over the last quarter of the logged time.
 """
@@ -18,12 +20,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-def order_of(path):
-    with open(path) as f:
-        steps = [json.loads(line[len("melt "):]) for line in f if line.startswith("melt {")]
-    if not steps or "nematic_order" not in steps[0]:
-        sys.exit(f"{path}: no melt lines with nematic_order (run brownian_rods with --progress K)")
-    return [s["step"] for s in steps], [s["nematic_order"] for s in steps]
+def order_of(paths):
+    steps, order = [], []
+    for path in paths.split(","):
+        with open(path) as f:
+            lines = [json.loads(line[len("melt "):]) for line in f if line.startswith("melt {")]
+        if not lines or "nematic_order" not in lines[0]:
+            sys.exit(f"{path}: no melt lines with nematic_order (run brownian_rods with --progress K)")
+        offset = steps[-1] if steps else 0
+        steps += [offset + s["step"] for s in lines]
+        order += [s["nematic_order"] for s in lines]
+    return steps, order
 
 
 def main():
