@@ -66,8 +66,8 @@
 // bars of that series.
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
 #include <stokescontact/dynamics/nematic_order.hpp>
-#include <stokescontact/io/checkpoint.hpp>
 #include <stokescontact/dynamics/time_stepper.hpp>
+#include <stokescontact/io/checkpoint.hpp>
 #include <stokescontact/io/diagnostics_json.hpp>
 #include <stokescontact/io/json.hpp>
 #include <stokescontact/mobility/free_draining.hpp>
