@@ -98,6 +98,7 @@
 
 #include "stokescontact/contact/contact_step.hpp"
 #include "stokescontact/contact/solvers/delassus_probing.hpp"
+#include "stokescontact/core/sparse_columns.hpp"
 #include "stokescontact/lcp/minimum_map_newton.hpp"
 #include "stokescontact/lcp/model_started_newton.hpp"
 #include "stokescontact/contact/solvers/secant_update.hpp"
@@ -244,14 +245,7 @@ template <Shape S, MobilityOperator M>
 Eigen::SparseMatrix<double> iterate_jacobian(const ContactStep<S, M>& step, const ContactEvaluation& e,
                                              std::span<const Eigen::Index> W) {
   using Sparse = Eigen::SparseMatrix<double>;
-  const Sparse& MD = *step.sparse_MD();
-  Sparse MD_W(MD.rows(), static_cast<Eigen::Index>(W.size()));
-  std::vector<Eigen::Index> counts(W.size());
-  for (std::size_t c = 0; c < W.size(); ++c) counts[c] = MD.col(W[c]).nonZeros();
-  MD_W.reserve(counts);
-  for (std::size_t c = 0; c < W.size(); ++c)
-    for (Sparse::InnerIterator it(MD, W[c]); it; ++it) MD_W.insert(it.row(), static_cast<Eigen::Index>(c)) = it.value();
-  MD_W.makeCompressed();
+  const Sparse MD_W = select_columns(*step.sparse_MD(), W);
   return step.problem().dt * Sparse(step.contact_matrix_at(e, W).transpose() * MD_W);
 }
 

@@ -34,6 +34,7 @@
 #include <Eigen/Sparse>
 
 #include "stokescontact/contact/contact_step.hpp"
+#include "stokescontact/core/sparse_columns.hpp"
 #include "stokescontact/geometry/broad_phase.hpp"
 
 namespace stokescontact {
@@ -109,12 +110,7 @@ class DelassusProbing {
   // The columns of A = dt D^T (M D) for the members from first_new on, exact (blocks mode).
   void read_exact_columns(double dt, const SparseMatrix& D, const SparseMatrix& MD, Eigen::Index first_new) {
     const auto count = static_cast<Eigen::Index>(members_.size()) - first_new;
-    std::vector<Eigen::Triplet<double>> select;
-    for (Eigen::Index m = 0; m < count; ++m)
-      select.emplace_back(static_cast<int>(members_[static_cast<std::size_t>(first_new + m)]), static_cast<int>(m), 1.0);
-    SparseMatrix selector(nc_, count);
-    selector.setFromTriplets(select.begin(), select.end());
-    const SparseMatrix MD_new = MD * selector;
+    const SparseMatrix MD_new = select_columns(MD, std::span<const Eigen::Index>(members_).subspan(static_cast<std::size_t>(first_new)));
     const SparseMatrix columns = dt * SparseMatrix(D.transpose() * MD_new);
     for (Eigen::Index m = 0; m < count; ++m)
       for (SparseMatrix::InnerIterator it(columns, m); it; ++it)
