@@ -169,6 +169,8 @@ TEST(Checkpoint, BadFilesAreRefusedNamingTheLine) {
   expect_rejects([&] { read_text(replaced("time 0", "time nan")); }, "line 2");
   expect_rejects([&] { read_text(replaced("box 10 10 10", "box 10 -1 10")); }, "line 3: the box lengths");
   expect_rejects([&] { read_text(replaced("bodies 2", "bodies 3")); }, "line 7: cannot read a pose");
+  expect_rejects([&] { read_text(good.substr(0, good.find("4 5 6"))); }, "ends after line 5, before pose 1 of 2");
+  expect_rejects([&] { read_text(replaced("bodies 2", "bodies 4000000000000000000")); }, "line 7: cannot read a pose");
   expect_rejects([&] { read_text(replaced("4 5 6 1 0 0 0", "4 5 6 1 0 0 0.5")); }, "line 6: the pose");
   expect_rejects([&] { read_text(replaced("1 2 3 1 0 0 0", "1 2 3 1 0 0")); }, "line 5: cannot read a pose");
   expect_rejects([&] { read_text(replaced("noise 1 0", "noise 1 7")); }, "line 7: cannot read the Brownian stream");

@@ -104,11 +104,13 @@ class CheckpointReader {
     return words;
   }
 
-  std::istringstream next_line(std::string_view what) {
+  // The next line into `words`; false at the end of the input.
+  bool next_line(std::istringstream& words) {
     std::string text;
-    if (!std::getline(in_, text)) fail_at_end(what);
+    if (!std::getline(in_, text)) return false;
     ++number_;
-    return std::istringstream(text);
+    words = std::istringstream(text);
+    return true;
   }
 
   // Nothing but white space may follow what was read from `words`.
@@ -173,15 +175,17 @@ inline Checkpoint read_checkpoint(std::istream& in, std::string_view source = "c
     r.finish(count, "the number of bodies");
     if (bodies < 0) r.fail("the number of bodies must be >= 0");
   }
-  c.poses.resize(static_cast<std::size_t>(bodies));
-  for (Pose& p : c.poses) {
-    std::istringstream words = r.next_line("pose " + std::to_string(&p - c.poses.data()) + " of " +
-                                           std::to_string(bodies));
+  // Pose by pose as read (no storage claimed for a count the file may not hold).
+  for (long long k = 0; k < bodies; ++k) {
+    std::istringstream words;
+    if (!r.next_line(words)) r.fail_at_end("pose " + std::to_string(k) + " of " + std::to_string(bodies));
+    Pose p;
     double w = 0.0, x = 0.0, y = 0.0, z = 0.0;
     words >> p.x[0] >> p.x[1] >> p.x[2] >> w >> x >> y >> z;
     r.finish(words, "a pose: x y z qw qx qy qz");
     p.q = Quat(w, x, y, z);
     if (!is_valid(p)) r.fail("the pose is not finite or its quaternion is not of unit length");
+    c.poses.push_back(p);
   }
   {
     std::istringstream noise = r.line("noise");
