@@ -30,9 +30,15 @@
 // after it to stderr as JSON).
 // Continuing a run (io/checkpoint.hpp): --save-state FILE writes the melt's state (time, box,
 // poses, the Brownian stream) every --save-every melt steps and at the melt's end (without a
-// melt: the start); --load-state FILE starts from such a file instead of --start (same --n,
-// --aspect and packing: the box must match), and its melt goes on with the saved stream, so
-// `--melt 2 --save-state s` then `--load-state s --melt 3` takes the same steps as `--melt 5`.
+// melt: the start); --load-state FILE starts from such a file instead of --start (same --n
+// and --aspect), and its melt goes on with the saved stream, so `--melt 2 --save-state s` then
+// `--load-state s --melt 3` takes the same steps as `--melt 5`. A file saved at another
+// packing is brought to --eta first: a denser one expanded in one affine rescaling of the
+// centres and the box (rescale_centres, scenes/periodic_placement.hpp: no gap between
+// spherocylinders shortens), a more dilute one compressed as --start compressed does (steps
+// of --compress-rate, --compress-steps Brownian steps each); the expansion and compression
+// runs of a hysteresis loop across the isotropic-nematic transition (the clock goes on from
+// the file's time; the compression's steps, as those of --start compressed, are not counted).
 // One Brownian stream runs through the whole program (the compression's steppers, the melt,
 // then each measured run from the melt's end): no phase draws the seed's first variates again.
 // Every (U0, dt) runs from that start; given several --dt, a row "dt -> 0" per U0
@@ -172,8 +178,9 @@ Options parse(int argc, char** argv) {
     if (!o.eta) throw std::invalid_argument("--start compressed needs --eta (the packing it compresses to)");
     if (!(o.compress_from > 0.0 && o.compress_from < *o.eta))
       throw std::invalid_argument("--compress-from must lie in (0, --eta)");
-    if (!(o.compress_rate > 0.0 && o.compress_rate < 0.1)) throw std::invalid_argument("--compress-rate must lie in (0, 0.1)");
   }
+  if (!(o.compress_rate > 0.0 && o.compress_rate < 0.1))  // also for a --load-state at a lower packing
+    throw std::invalid_argument("--compress-rate must lie in (0, 0.1)");
   o.melt = args.number("--melt", 0.0, 0.0);
   o.melt_dt = args.number("--melt-dt", 1e-3, 0.0);
   if (!(o.melt_dt > 0.0)) throw std::invalid_argument("--melt-dt must be > 0");
@@ -261,7 +268,7 @@ void compress(const Options& o, System s, std::vector<sc::Pose>& poses, double t
   while (s.side > to_side) {
     const double factor = std::max(to_side / s.side, 1.0 - rate);
     std::vector<sc::Pose> scaled = poses;
-    for (sc::Pose& p : scaled) p.x *= factor;
+    sc::rescale_centres(scaled, factor);
     const sc::PeriodicBox box{sc::Vec3::Constant(s.side * factor)};
     if (sc::minimum_pair_distance(s.rod, std::span<const sc::Pose>(scaled), box).distance < 0.5 * o.d_hat) {
       rate *= 0.5;
@@ -313,13 +320,23 @@ int run(const Options& o) {
     if (c.poses.size() != o.n)
       throw std::invalid_argument("--load-state " + o.load_state + " holds " + std::to_string(c.poses.size()) +
                                   " rods, --n is " + std::to_string(o.n));
-    if (!c.box || (c.box->lengths.array() - s.side).abs().maxCoeff() > 1e-12 * s.side)
-      throw std::invalid_argument("--load-state " + o.load_state + ": its box is not the cube of side " +
-                                  std::to_string(s.side) + " that --n and the packing give");
+    if (!c.box || (c.box->lengths.array() - c.box->lengths.x()).abs().maxCoeff() > 1e-12 * c.box->lengths.x())
+      throw std::invalid_argument("--load-state " + o.load_state + ": its box is not a cube");
     if (!c.noise) throw std::invalid_argument("--load-state " + o.load_state + " holds no Brownian stream");
     start = c.poses;
     noise = *c.noise;
     start_time = c.time;
+    const double saved_side = c.box->lengths.x();
+    if (saved_side < s.side * (1.0 - 1e-12)) {  // a denser state: expanded at once, no gap shortens
+      sc::rescale_centres(start, s.side / saved_side);
+      std::printf("expansion: side %.6g -> %.6g (eta %.4f -> %.4f) in one rescaling, every gap kept or widened\n",
+                  saved_side, s.side, eta * std::pow(s.side / saved_side, 3), eta);
+    } else if (saved_side > s.side * (1.0 + 1e-12)) {  // a more dilute state: compressed as --start compressed
+      System from = s;
+      from.side = saved_side;
+      std::printf("compression from eta %.4f:\n", eta * std::pow(s.side / saved_side, 3));
+      compress(o, from, start, s.side, noise);
+    }
   } else if (o.start == "aligned") {
     start = sc::periodic_aligned_columns(s.rod, o.n, s.side, o.d_hat, o.seed);
   } else if (o.start == "random") {

@@ -2,7 +2,8 @@
 # saved, read back by --load-state and continued for 10 more. The two checkpoints must hold
 # the same poses and Brownian stream to the last digit (io/checkpoint.hpp); the time lines
 # may differ in the last bit (t0 + 20 dt against (t0 + 10 dt) + 10 dt) and are not compared.
-# Then the checkpoint loaded with another --n must be refused.
+# Then the checkpoint loaded with another --n must be refused, and loaded at another packing
+# it must be expanded or compressed to it.
 # Usage: cmake -DDRIVER=<brownian_rods> -DWORK_DIR=<dir> -P check_continued_run.cmake
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR})
@@ -35,4 +36,29 @@ execute_process(COMMAND ${DRIVER} ${common} --load-state ${WORK_DIR}/half.checkp
 if(rc EQUAL 0 OR NOT "${out}${err}" MATCHES "holds 300 rods, --n is 200")
   message(FATAL_ERROR "ERROR: a checkpoint of 300 rods loaded with --n 200 gave ${rc}:\n${out}\n${err}")
 endif()
-message(STATUS "continued run: the same 300 poses and Brownian stream as the uninterrupted run")
+# A checkpoint at another packing is brought to --eta: expanded at once (0.3 -> 0.28), or
+# compressed in rescalings with Brownian steps between them (0.3 -> 0.305); both then melt.
+list(TRANSFORM common REPLACE "^200$" "300")
+foreach(case IN ITEMS "0.28;expansion: side [0-9.]+ -> [0-9.]+ \\(eta 0.3000 -> 0.2800\\)"
+                      "0.305;compression from eta 0.3000:.*compression: [1-9][0-9]* rescalings")
+  list(POP_FRONT case eta)
+  set(args ${common})
+  list(FIND args --eta at)
+  math(EXPR at "${at} + 1")
+  list(REMOVE_AT args ${at})
+  list(INSERT args ${at} ${eta})
+  execute_process(COMMAND ${DRIVER} ${args} --load-state ${WORK_DIR}/half.checkpoint --melt 0.001
+                          --compress-rate 2e-3 --compress-steps 1 --save-state ${WORK_DIR}/at_${eta}.checkpoint
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT "${out}" MATCHES "${case}")
+    message(FATAL_ERROR "ERROR: the checkpoint at eta 0.3 loaded at --eta ${eta} gave ${rc}:\n${out}\n${err}")
+  endif()
+  # The file it saves is at the new packing: loaded again at --eta it is taken as it is.
+  execute_process(COMMAND ${DRIVER} ${args} --load-state ${WORK_DIR}/at_${eta}.checkpoint --melt 0.001
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR "${out}" MATCHES "expansion|compression")
+    message(FATAL_ERROR "ERROR: the checkpoint saved at --eta ${eta} was not taken as it is:\n${out}\n${err}")
+  endif()
+endforeach()
+message(STATUS "continued run: the same 300 poses and Brownian stream as the uninterrupted run; "
+               "a checkpoint expanded and compressed to another packing")

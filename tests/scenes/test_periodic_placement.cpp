@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,16 @@ double smallest_gap_over_images(const S& shape, const std::vector<sc::Pose>& pos
             best = std::min(best, sc::closest_points(shape, poses[i], shape, image).distance);
           }
   return best;
+}
+
+// Each pair's smallest gap over the 27 neighbouring images, pairs in order (i < j).
+template <sc::Shape S>
+std::vector<double> pair_gaps_over_images(const S& shape, const std::vector<sc::Pose>& poses, double side) {
+  std::vector<double> gaps;
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (std::size_t j = i + 1; j < poses.size(); ++j)
+      gaps.push_back(smallest_gap_over_images(shape, std::vector<sc::Pose>{poses[i], poses[j]}, side));
+  return gaps;
 }
 
 TEST(PeriodicPlacement, RodsAreContactFreeAcrossTheBoundaryAndInsideTheBox) {
@@ -101,6 +112,34 @@ TEST(PeriodicPlacement, AlignedColumnsReachADenseContactFreeStart) {
   const std::vector<sc::Pose> again = sc::periodic_aligned_columns(rod, count, side, gap, 3);
   for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(poses[k].x, again[k].x);
   EXPECT_NE(poses[0].x, sc::periodic_aligned_columns(rod, count, side, gap, 4)[0].x);
+}
+
+// rescale_centres: an expansion widens or keeps every pair's gap (brute force over the 27
+// images, each pair on its own), however little or much; a compression narrows some.
+TEST(PeriodicPlacement, AnExpansionShortensNoGapBetweenRods) {
+  const sc::Spherocylinder rod{5.0, 0.5};
+  const double side = 13.0;
+  const std::vector<sc::Pose> start = sc::periodic_random_placement(rod, 60, side, 0.01, 11);
+  const std::vector<double> before = pair_gaps_over_images(rod, start, side);
+  ASSERT_LT(*std::min_element(before.begin(), before.end()), 0.3);  // some pairs nearly touch
+  for (const double factor : {1.0 + 1e-9, 1.0 + 1e-4, 1.01, 1.2, 2.0}) {
+    std::vector<sc::Pose> poses = start;
+    sc::rescale_centres(poses, factor);
+    const std::vector<double> after = pair_gaps_over_images(rod, poses, factor * side);
+    for (std::size_t k = 0; k < before.size(); ++k)
+      ASSERT_GE(after[k], before[k] - 1e-12 * side) << "pair " << k << ", factor " << factor;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      EXPECT_DOUBLE_EQ(poses[k].x.x(), factor * start[k].x.x());
+      EXPECT_EQ(poses[k].q.coeffs(), start[k].q.coeffs());
+    }
+  }
+  std::vector<sc::Pose> compressed = start;
+  sc::rescale_centres(compressed, 0.99);
+  const std::vector<double> after = pair_gaps_over_images(rod, compressed, 0.99 * side);
+  EXPECT_LT(*std::min_element(after.begin(), after.end()), *std::min_element(before.begin(), before.end()));
+  std::vector<sc::Pose> poses = start;
+  for (const double factor : {0.0, -1.0, std::numeric_limits<double>::infinity(), std::nan("")})
+    test_support::expect_rejects([&] { sc::rescale_centres(poses, factor); }, "factor");
 }
 
 TEST(PeriodicPlacement, AlignedColumnsRejectAPackingTheyCannotHold) {

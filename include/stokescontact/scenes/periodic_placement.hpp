@@ -20,10 +20,14 @@
 // empty), each moved by a uniform jitter that keeps neighbouring columns more than 2 radius +
 // min_gap apart. The dynamics then melts the order (or keeps it, above the isotropic-nematic
 // transition).
+//
+// rescale_centres: the affine rescaling of a placed suspension (compression towards a denser
+// packing, expansion towards a more dilute one), with the reason an expansion is safe.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -123,6 +127,22 @@ inline std::vector<Pose> periodic_aligned_columns(const Spherocylinder& rod, std
       poses.push_back(Pose{Vec3(x, y, std::fmod(offset + static_cast<double>(r) * period, side)), Quat::Identity()});
   }
   return poses;
+}
+
+// Every centre scaled by `factor` about the origin, orientations kept: the affine rescaling
+// of a suspension in the cube [0, side)^3 to the cube [0, factor side)^3 (the caller scales
+// the box; wrapped centres stay wrapped). An expansion (factor >= 1) shortens no gap between
+// convex bodies that contain their own centre (spheres, spherocylinders), through any
+// periodic image: with centre offset r the gap of a pair is dist(r, K), K = {a - b} over the
+// two bodies placed at their centres, a convex set that holds 0; t -> dist(t r, K) is convex
+// and 0 at t = 0, so it is nondecreasing for t >= 0, and every image's offset scales with
+// the box. (A compression shortens gaps; a non-convex body, the boomerang, may come closer
+// to a neighbour even as the suspension expands.) Throws std::invalid_argument naming
+// "factor" unless it is positive and finite.
+inline void rescale_centres(std::span<Pose> poses, double factor) {
+  if (!(factor > 0.0 && std::isfinite(factor)))
+    fail_argument("factor", "must be positive and finite, got " + std::to_string(factor));
+  for (Pose& p : poses) p.x *= factor;
 }
 
 }  // namespace stokescontact
