@@ -55,9 +55,10 @@ struct LcpSequenceOptions {
   // distances, so what it guarantees is unchanged; an iterate far from separation is not
   // solved to 1e-8 only to be re-linearised. The first LCP (the only one for spheres) and every
   // LCP of a polishing sequence (tol > 0, aiming at complementarity) are solved to
-  // lcp.tolerance. 0: every LCP to lcp.tolerance. (400 Brownian rods at eta 0.44, lcp-apgd,
-  // 40 steps: 1.6x less time at the same LCP count and the same poses to 5 digits after 40
-  // steps; docs/results.md, "Inexact LCPs in the sequence".)
+  // lcp.tolerance. 0: every LCP to lcp.tolerance. (400 Brownian rods at eta 0.44, 40 steps:
+  // 1.3-1.6x less time for lcp-newton, lcp-apgd and lcp-bbpgd at the same LCP count, S after
+  // them the same to 4 digits; matrix-free, 3.75x fewer applications of A; docs/results.md,
+  // "Inexact LCPs in the sequence".)
   double forcing = 0.01;
   static constexpr double kForcingCap = 1e-2;  // never looser than 1% of ||b_k||_inf
 
