@@ -6,7 +6,9 @@ usage: scripts/plot_nematic_order.py OUT.png DT_D_R LABEL=LOG[,LOG...] [LABEL=LO
 
 DT_D_R: the melt's step in rotational times (--melt-dt); time is step x DT_D_R. Several logs
 of one label are one run continued (brownian_rods --load-state): each log's steps count on
-from the previous log's last logged step (so --progress must divide the melt's steps). Prints per
+from the previous log's last logged step (so --progress must divide the melt's steps);
+LOG:STEP keeps a log's lines up to that step (a run branched from a checkpoint of another:
+the other's log up to the checkpoint, then the branch's log). Prints per
 log: the steps logged, the last time, S at the start and the end, and the mean and spread of S
 over the last quarter of the logged time.
 """
@@ -22,9 +24,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 def order_of(paths):
     steps, order = [], []
-    for path in paths.split(","):
+    for spec in paths.split(","):
+        path, _, last = spec.partition(":")
         with open(path) as f:
             lines = [json.loads(line[len("melt "):]) for line in f if line.startswith("melt {")]
+        if last:
+            lines = [s for s in lines if s["step"] <= int(last)]
         if not lines or "nematic_order" not in lines[0]:
             sys.exit(f"{path}: no melt lines with nematic_order (run brownian_rods with --progress K)")
         offset = steps[-1] if steps else 0
