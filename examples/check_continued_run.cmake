@@ -3,7 +3,7 @@
 # the same poses and Brownian stream to the last digit (io/checkpoint.hpp); the time lines
 # may differ in the last bit (t0 + 20 dt against (t0 + 10 dt) + 10 dt) and are not compared.
 # Then the checkpoint loaded with another --n must be refused, and loaded at another packing
-# it must be expanded or compressed to it.
+# it must be expanded or compressed to it. Last, a run stopped by a timeout must keep its lines.
 # Usage: cmake -DDRIVER=<brownian_rods> -DWORK_DIR=<dir> -P check_continued_run.cmake
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR})
@@ -60,5 +60,12 @@ foreach(case IN ITEMS "0.28;expansion: side [0-9.]+ -> [0-9.]+ \\(eta 0.3000 -> 
     message(FATAL_ERROR "ERROR: the checkpoint saved at --eta ${eta} was not taken as it is:\n${out}\n${err}")
   endif()
 endforeach()
+# A long run stopped from outside (here by execute_process's timeout) keeps the lines it
+# printed: the driver's stdout is line-buffered even into a pipe or a file (cli.hpp).
+execute_process(COMMAND ${DRIVER} ${common} --load-state ${WORK_DIR}/half.checkpoint --melt 100 TIMEOUT 5
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT "${out}" MATCHES "Brownian rods: N = 300 spherocylinders")
+  message(FATAL_ERROR "ERROR: a run stopped after 5 s gave ${rc} and lost its first lines:\n${out}\n${err}")
+endif()
 message(STATUS "continued run: the same 300 poses and Brownian stream as the uninterrupted run; "
-               "a checkpoint expanded and compressed to another packing")
+               "a checkpoint expanded and compressed to another packing; a stopped run keeps its lines")

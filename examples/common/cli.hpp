@@ -187,8 +187,11 @@ inline double maximum(const std::vector<double>& v) {
 // A driver's main: `parse` throwing std::invalid_argument prints the error and the usage
 // (exit 2), `run` throwing anything prints the error (exit 1). A `run` that returns an int
 // gives the exit status itself (a run that found an ERROR); one that returns nothing exits 0.
+// stdout is line-buffered, redirected or not: each JSON line reaches its file when printed, so
+// a long run stopped by a signal (timeout, a killed job) keeps every line it wrote.
 template <typename Parse, typename Run>
 int driver_main(const char* name, const char* usage, Parse&& parse, Run&& run) {
+  std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
   try {
     parse();
   } catch (const std::invalid_argument& e) {

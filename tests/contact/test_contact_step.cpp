@@ -411,6 +411,45 @@ TEST(ContactStep, GuaranteeFailureIsReportedNotHidden) {
   }
 }
 
+// A solver core that does not converge and leaves its own flagged pair overlapping ends the
+// step at once: a further guarantee round would only add constraints to a problem it did not
+// solve. The chain scene: pushing pair (0, 1) by x = dt m lambda moves sphere 1 by x into
+// sphere 2 (gap 0.03, not flagged), and leaves (0, 1) at -0.1 + 2x and (1, 2) at 0.03 - x.
+// x = 0.04: (0, 1) at -0.02, overlapping: the step ends after the round.
+// x = 0.052: (0, 1) at 0.004, short of d_hat = 0.01 but not overlapping, and x = 0.06: (0, 1)
+// at 0.02, separated. Either way the loop adds (1, 2) (at -0.022, -0.03) and solves again, as
+// before; that round, pushing (0, 1) only, leaves (1, 2) overlapping and ends the step.
+TEST(ContactStep, ARoundThatLeavesItsOwnPairsOverlappingEndsTheStep) {
+  const SphereScene s = chain();
+  const sc::ContactStepProblem<sc::Sphere> problem = s.problem();
+  for (const double x : {0.04, 0.052, 0.06}) {
+    SCOPED_TRACE("x = " + std::to_string(x));
+    auto m = s.mobility();
+    m.set_configuration(s.poses);
+    sc::VecX push = sc::VecX::Zero(9);
+    push(0) = 1.0;
+    const double lambda = x / (s.dt * m.apply(push)(0));  // the same force on (0, 1) every round
+    int calls = 0;
+    const auto core = [&](sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility>& step, const sc::VecX&) {
+      ++calls;
+      sc::ContactSolveOutcome out;
+      out.lambda = sc::VecX::Zero(step.nc());
+      out.lambda(0) = lambda;
+      out.converged = false;
+      return out;
+    };
+    const sc::ContactStepResult r = sc::run_contact_step(problem, m, sc::ContactStepOptions{}, core);
+    EXPECT_EQ(r.status, sc::ContactStepStatus::failed_separation) << r.message;
+    EXPECT_NE(r.message.find("the solver left flagged pairs overlapping (no further round)"), std::string::npos)
+        << r.message;
+    const bool overlapping = x < 0.05;
+    EXPECT_EQ(calls, overlapping ? 1 : 2);
+    EXPECT_EQ(r.guarantee_rounds, overlapping ? 0 : 1);
+    EXPECT_EQ(r.flagged_pairs, overlapping ? 1u : 2u);
+    EXPECT_NEAR(r.min_distance_ratio * s.d_hat, overlapping ? -0.02 : 0.03 - x, 1e-9);
+  }
+}
+
 // A dense random scene (30 spheres, volume fraction 26%) with d_try deliberately at d_hat:
 // the trial step misses pairs, the guarantee loop adds them, and every pair ends separated.
 TEST(ContactStep, DenseSceneWithSmallDTryIsSeparatedByTheGuaranteeLoop) {
