@@ -6,13 +6,15 @@
 # continue ends with its message as the log's last line). Two runs at a time, one OpenMP
 # thread each (two processes of two spinning OpenMP threads on two cores are 2-4x slower).
 #
-#   scripts/dense_rod_solver_cost.sh BUILD_DIR OUT [STEPS=40] [TIMEOUT_S=150]
+#   scripts/dense_rod_solver_cost.sh BUILD_DIR OUT [STEPS=40] [TIMEOUT_S=150] [SOLVERS]
+# SOLVERS: a space-separated list, default "default lcp-bbpgd lcp-apgd lcp-newton".
 #   /usr/bin/python3 scripts/melt_log_table.py --cost OUT/*.log
 set -euo pipefail
 build=${1:?usage: dense_rod_solver_cost.sh BUILD_DIR OUT [STEPS] [TIMEOUT_S]}
 out=${2:?usage: dense_rod_solver_cost.sh BUILD_DIR OUT [STEPS] [TIMEOUT_S]}
 steps=${3:-40}
 limit=${4:-150}
+solvers=${5:-default lcp-bbpgd lcp-apgd lcp-newton}
 mkdir -p "$out"
 melt=$(awk -v n="$steps" 'BEGIN { printf "%.6g", n * 5e-4 }')
 run() {  # eta margin solver
@@ -25,7 +27,7 @@ run() {  # eta margin solver
 jobs_running=0
 for eta in 0.31 0.40 0.45; do
   for margin in 1e-3 0.3; do
-    for solver in default lcp-bbpgd lcp-apgd lcp-newton; do
+    for solver in $solvers; do
       run "$eta" "$margin" "$solver" &
       jobs_running=$((jobs_running + 1))
       if [ "$jobs_running" -ge 2 ]; then wait -n; jobs_running=$((jobs_running - 1)); fi

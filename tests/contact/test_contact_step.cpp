@@ -7,9 +7,13 @@
 #include <cstdio>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "common/test_support.hpp"
@@ -447,6 +451,89 @@ TEST(ContactStep, ARoundThatLeavesItsOwnPairsOverlappingEndsTheStep) {
     EXPECT_EQ(r.guarantee_rounds, overlapping ? 0 : 1);
     EXPECT_EQ(r.flagged_pairs, overlapping ? 1u : 2u);
     EXPECT_NEAR(r.min_distance_ratio * s.d_hat, overlapping ? -0.02 : 0.03 - x, 1e-9);
+  }
+}
+
+// A working-set problem given to a default-solver round in place of the LCP: each correction
+// goes `step` of the way to the exact LCP's answer for `target_scale` times the round's target,
+// and with `frozen`, every correction after the first leaves lambda as it is.
+struct ScriptedModel {
+  double target_scale = 1.0;
+  double step = 1.0;
+  bool frozen = false;
+  sc::detail::WorkingSetLcp exact{sc::LcpOptions{1e-12}};
+  std::string_view name = "scripted model";
+  template <sc::LcpMatrixOperator Model>
+  std::optional<sc::VecX> operator()(const Model& A, std::span<const Eigen::Index> W, const sc::VecX& lambda,
+                                     const sc::VecX& distances, double target,
+                                     const sc::detail::Correction& correction) const {
+    if (frozen && lambda.sum() > 0.0) return lambda;
+    std::optional<sc::VecX> full = exact(A, W, lambda, distances, target_scale * target, correction);
+    if (full) *full = lambda + step * (*full - lambda);
+    return full;
+  }
+};
+
+// One contact step of scene `s` at separation margin `margin`, each round the default solver's
+// with `model` in place of its working-set LCP (no ray search, no early end check).
+sc::ContactStepResult step_with_scripted_rounds(const SphereScene& s, double margin,
+                                                const sc::DefectCorrectionOptions& solver, const ScriptedModel& model) {
+  auto m = s.mobility();
+  sc::ContactStepOptions options;
+  options.separation_margin = margin;
+  return sc::run_contact_step(s.problem(), m, options,
+                              [&](sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility>& step, const sc::VecX& warm) {
+                                return sc::detail::solve_defect_correction_round(step, warm, solver, model,
+                                                                                 {false, false});
+                              });
+}
+
+// A default-solver round that makes no progress at an iterate the step counts separated ends
+// there, not converged (DefectCorrectionOptions::separated_stall_corrections). Two spheres
+// head on (trial gap -0.03), and a working-set problem that stalls (ScriptedModel aiming at
+// 0.95 of the target, frozen after its first correction): the first correction
+// leaves the pair at 0.95 d_hat (1 + margin), the second changes lambda by 0 (progress: its
+// change is below the first's), and from the third on neither the shortfall nor the change
+// falls. Separation margin 0.3 counts 0.95 d_hat separated: the round ends after 2 + `stall`
+// corrections, with lambda at that iterate. Margin 1e-3 does not, nor does a stall count of 0
+// (never): the round spends its 50 corrections, and the step fails at margin 1e-3.
+TEST(ContactStep, ARoundThatStallsInsideTheSeparationMarginEndsThere) {
+  const SphereScene s = head_on(0.02, 2.5);
+  for (const auto& [margin, stall, corrections] :
+       std::vector<std::tuple<double, int, int>>{{0.3, 6, 8}, {0.3, 2, 4}, {1e-3, 6, 50}, {0.3, 0, 50}}) {
+    SCOPED_TRACE("separation margin " + std::to_string(margin) + ", stall " + std::to_string(stall));
+    sc::DefectCorrectionOptions solver;
+    solver.separated_stall_corrections = stall;
+    const sc::ContactStepResult r = step_with_scripted_rounds(s, margin, solver, ScriptedModel{0.95, 1.0, true});
+    EXPECT_EQ(r.iterations, corrections) << r.message;
+    EXPECT_NEAR(r.min_distance_ratio, 0.95 * (1.0 + solver.margin), 1e-9);
+    if (margin == 0.3) {
+      EXPECT_EQ(r.status, sc::ContactStepStatus::not_converged) << r.message;
+    } else {
+      EXPECT_EQ(r.status, sc::ContactStepStatus::failed_separation) << r.message;  // 0.95 < 1 - 1e-3
+    }
+    const bool ended = stall > 0 && margin == 0.3;
+    EXPECT_EQ(r.message.find("no progress in " + std::to_string(stall) + " corrections inside the separation margin") !=
+                  std::string::npos,
+              ended)
+        << r.message;
+  }
+}
+
+// Progress is any contraction, not a fast one: corrections that halve the error each time
+// (ScriptedModel going half of the way; shortfall and change of lambda halve, as Newton's on a
+// double root) converge, with the separation margin at 0.3 as at 1e-3, and
+// are not cut short by DefectCorrectionOptions::separated_stall_corrections.
+TEST(ContactStep, ARoundConvergingAtHalfRateIsNotCutShort) {
+  const SphereScene s = head_on(0.02, 2.5);
+  for (const double margin : {0.3, 1e-3}) {
+    SCOPED_TRACE("separation margin " + std::to_string(margin));
+    const sc::DefectCorrectionOptions solver;
+    const sc::ContactStepResult r = step_with_scripted_rounds(s, margin, solver, ScriptedModel{1.0, 0.5, false});
+    EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+    EXPECT_GT(r.iterations, solver.separated_stall_corrections + 2);
+    EXPECT_LT(r.iterations, solver.max_iterations);
+    EXPECT_GE(r.min_distance_ratio, 1.0);
   }
 }
 

@@ -68,7 +68,11 @@
 // the next correction would change lambda by less than tol ||lambda||_inf; that iterate is
 // returned, so separation is measured, never predicted. The margin puts roundoff and the
 // remaining probing error on the separated side; it costs a relative force excess of about
-// margin d_hat / (the overlap the force removes).
+// margin d_hat / (the overlap the force removes). A round whose corrections stop making progress
+// at an iterate within the step's separation margin (no pair below it, no pushed pair above it)
+// returns it, not converged (DefectCorrectionOptions::separated_stall_corrections): a rod's gap
+// at an overlap end can have a maximum along its own force near d_hat (the force turns the
+// rod), so the corrections creep up to it or cycle below it.
 //
 // Cost: the probes (one per colour of each batch of new working-set pairs) plus one
 // application per iteration; 0 when no pair comes below d_hat. In formed mode every probe is
@@ -117,6 +121,17 @@ struct DefectCorrectionOptions {
                                       // the LCP sequence after two)
   double contraction = 0.5;           // a correction must shrink the shortfall by this factor ...
                                       // ... or, twice in a row, the LCP sequence takes over
+  // A round that has made no progress for this many corrections in a row, at an iterate within
+  // the step's separation margin m = ContactStepOptions::separation_margin of eq. 27 (every
+  // flagged pair at d >= d_hat (1 - m), every pushed pair at d <= d_hat (1 + m)), ends there,
+  // not converged: it returns that iterate instead of spending the rest of max_iterations (0:
+  // never). A far root's iterates (pushed pairs many d_hat apart) go on as before. Progress: a
+  // shortfall below 0.9 of the round's least so far, or a change of lambda below 0.9 of its
+  // least (a sequence converging at any linear rate makes progress every correction). On dense Brownian rods (400, L/D = 5,
+  // eta 0.40-0.45) rounds crept at 0.9996 d_hat with changes of 1e-5 of ||lambda||_inf, or
+  // cycled between 0.92 and 0.95 d_hat, for 40 corrections and more each (docs/results.md,
+  // "A round that stalls separated ends").
+  int separated_stall_corrections = 6;
   LcpOptions lcp{1e-12};              // each small LCP's stopping rule, at its tightest
   // Inexact corrections (as in inexact Newton, Dembo, Eisenstat & Steihaug 1982): a correction's
   // LCP is solved only as far as the iteration needs, to the tolerance
@@ -181,6 +196,9 @@ struct DefectCorrectionOptions {
       fail_argument("DefectCorrectionOptions.contraction", "must lie in (0, 1], got " + std::to_string(contraction));
     if (ray_samples < 2)
       fail_argument("DefectCorrectionOptions.ray_samples", "must be >= 2, got " + std::to_string(ray_samples));
+    if (separated_stall_corrections < 0)
+      fail_argument("DefectCorrectionOptions.separated_stall_corrections",
+                    "must be >= 0, got " + std::to_string(separated_stall_corrections));
     if (stall_corrections < 1)
       fail_argument("DefectCorrectionOptions.stall_corrections",
                     "must be >= 1, got " + std::to_string(stall_corrections));
@@ -456,6 +474,17 @@ ContactSolveOutcome finish_by_lcp_sequence(ContactStep<S, M>& step, const VecX& 
   return out;
 }
 
+// Whether an iterate lies within the step's separation margin m of Broms eq. 27's distances:
+// every flagged pair at d >= d_hat (1 - m) (separated, as the step counts it) and every pushed
+// pair at d <= d_hat (1 + m) (held, not flung apart: a far root's pairs end many d_hat apart).
+template <Shape S, MobilityOperator M>
+bool within_separation_margin(const ContactStep<S, M>& step, const VecX& lambda, const VecX& distances) {
+  const double m = step.options().separation_margin, d_hat = step.problem().d_hat;
+  for (Eigen::Index k = 0; k < lambda.size(); ++k)
+    if (!step.separated(distances(k)) || (lambda(k) > 0.0 && distances(k) > d_hat * (1.0 + m))) return false;
+  return true;
+}
+
 // What a round may do besides its corrections: search rays for a nearer root, and check the
 // end early (DefectCorrectionOptions::early_end_check). A round started again does neither twice.
 struct RoundChoices {
@@ -528,6 +557,11 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
   double best_shortfall = std::numeric_limits<double>::infinity();
   VecX best_lambda = lambda, best_MD, best_distances;  // best_MD: M D best_lambda
   int slow_corrections = 0;
+  // separated_stall_corrections: the least shortfall and relative change of lambda so far, and
+  // the corrections since either last fell below 0.9 of its least
+  double progress_shortfall = std::numeric_limits<double>::infinity();
+  double progress_change = std::numeric_limits<double>::infinity();
+  int without_progress = 0;
   double last_change = 1.0;  // of lambda, relative to ||lambda||_inf: sets the next LCP's tolerance
   for (;;) {
     const ContactEvaluation& e = step.evaluate(lambda);
@@ -585,6 +619,20 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
                                          "corrections stalled " + std::to_string(stalled) + " times");
           break;
         }
+    }
+    // No progress, but separated as the step counts it: that iterate is the round's answer
+    // (not converged), and the guarantee loop checks it like any other.
+    const bool progress = shortfall < 0.9 * progress_shortfall ||
+                          (out.iterations > 0 && last_change < 0.9 * progress_change);
+    progress_shortfall = std::min(progress_shortfall, shortfall);
+    if (out.iterations > 0) progress_change = std::min(progress_change, last_change);
+    without_progress = progress ? 0 : without_progress + 1;
+    if (options.separated_stall_corrections > 0 && without_progress >= options.separated_stall_corrections &&
+        within_separation_margin(step, lambda, e.distances)) {
+      out.message = std::string(subproblem.name) + ": no progress in " + std::to_string(without_progress) +
+                    " corrections inside the separation margin, min flagged d / d_hat = " +
+                    std::to_string(e.min_distance() / d_hat) + " (returned as it is)";
+      break;
     }
     previous_shortfall = shortfall;
     VecX next;
