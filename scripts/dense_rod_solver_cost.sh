@@ -10,8 +10,8 @@
 # SOLVERS: a space-separated list, default "default lcp-bbpgd lcp-apgd lcp-newton".
 #   /usr/bin/python3 scripts/melt_log_table.py --cost OUT/*.log
 set -euo pipefail
-build=${1:?usage: dense_rod_solver_cost.sh BUILD_DIR OUT [STEPS] [TIMEOUT_S]}
-out=${2:?usage: dense_rod_solver_cost.sh BUILD_DIR OUT [STEPS] [TIMEOUT_S]}
+build=${1:?usage: dense_rod_solver_cost.sh BUILD_DIR OUT [STEPS] [TIMEOUT_S] [SOLVERS]}
+out=${2:?usage: dense_rod_solver_cost.sh BUILD_DIR OUT [STEPS] [TIMEOUT_S] [SOLVERS]}
 steps=${3:-40}
 limit=${4:-150}
 solvers=${5:-default lcp-bbpgd lcp-apgd lcp-newton}

@@ -127,10 +127,10 @@ struct DefectCorrectionOptions {
   // not converged: it returns that iterate instead of spending the rest of max_iterations (0:
   // never). A far root's iterates (pushed pairs many d_hat apart) go on as before. Progress: a
   // shortfall below 0.9 of the round's least so far, or a change of lambda below 0.9 of its
-  // least (a sequence converging at any linear rate makes progress every correction). On dense Brownian rods (400, L/D = 5,
-  // eta 0.40-0.45) rounds crept at 0.9996 d_hat with changes of 1e-5 of ||lambda||_inf, or
-  // cycled between 0.92 and 0.95 d_hat, for 40 corrections and more each (docs/results.md,
-  // "A round that stalls separated ends").
+  // least (a sequence converging at any linear rate makes progress every correction). On
+  // dense Brownian rods (400, L/D = 5, eta 0.40-0.45) rounds crept at 0.9996 d_hat with changes
+  // of 1e-5 of ||lambda||_inf, or cycled between 0.91 and 0.96 d_hat, for 35 corrections and
+  // more each (docs/results.md, "A round that stalls separated ends").
   int separated_stall_corrections = 6;
   LcpOptions lcp{1e-12};              // each small LCP's stopping rule, at its tightest
   // Inexact corrections (as in inexact Newton, Dembo, Eisenstat & Steihaug 1982): a correction's
@@ -620,7 +620,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
           break;
         }
     }
-    // No progress, but separated as the step counts it: that iterate is the round's answer
+    // No progress, but within the step's separation margin: that iterate is the round's answer
     // (not converged), and the guarantee loop checks it like any other.
     const bool progress = shortfall < 0.9 * progress_shortfall ||
                           (out.iterations > 0 && last_change < 0.9 * progress_change);
