@@ -12,6 +12,12 @@ min d / d_hat and the largest correction turn over the steps, and how the run en
 log's last line when it is not a step: the stepper's message, or the timeout's exit status).
 
     /usr/bin/python3 scripts/melt_log_table.py --cost LOG [LOG ...]
+
+With --totals, the sums that compare two builds on the same runs: solver iterations in all, the
+wall time in all and per iteration, the steps not converged (committed within the separation
+margin) and sub-stepped, and the smallest min d / d_hat.
+
+    /usr/bin/python3 scripts/melt_log_table.py --totals LOG [LOG ...]
 """
 import json
 import os
@@ -67,23 +73,39 @@ def cost_row(path):
             f"{end} |")
 
 
+def totals_row(path):
+    steps = steps_of(path)
+    if not steps:
+        return f"| {path} | 0 | | | | | | |"
+    iterations = sum(s["iterations"] for s in steps)
+    wall = sum(s["wall_time_s"] for s in steps)
+    not_converged = sum(1 for s in steps if s["status"] != "converged")
+    substepped = sum(1 for s in steps if s["substeps"] > 1)
+    return (f"| {path} | {len(steps)} | {iterations} | {wall:.1f} | {1000 * wall / max(iterations, 1):.2f} | "
+            f"{not_converged} | {substepped} | {min(s['min_distance_ratio'] for s in steps):.4f} |")
+
+
+TABLES = {  # option: (header, row of one log)
+    "--totals": (["log", "steps", "iterations", "wall (s)", "wall per iteration (ms)", "not converged",
+                  "sub-stepped", "min d / d_hat"], totals_row),
+    "--cost": (["log", "steps", "flagged pairs", "pushed pairs", "iterations", "sub-stepped", "solved again",
+                "median step (s)", "all steps (s)", "min d / d_hat", "largest turn (rad)", "end"], cost_row),
+    None: (["log", "steps", "sub-stepped", "status", "wall, all steps", "median step", "largest step",
+            "wall in sub-stepped steps"], row),
+}
+
+
 def main():
     args = sys.argv[1:]
-    cost = "--cost" in args
-    paths = [a for a in args if a != "--cost"]
+    option = next((a for a in args if a in TABLES), None)
+    paths = [a for a in args if a not in TABLES]
     if not paths:
         sys.exit(__doc__)
-    if cost:
-        print("| log | steps | flagged pairs | pushed pairs | iterations | sub-stepped | solved again | "
-              "median step (s) | all steps (s) | min d / d_hat | largest turn (rad) | end |")
-        print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-        for path in paths:
-            print(cost_row(path))
-        return
-    print("| log | steps | sub-stepped | status | wall, all steps | median step | largest step | wall in sub-stepped steps |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    header, make_row = TABLES[option]
+    print("| " + " | ".join(header) + " |")
+    print("|" + " --- |" * len(header))
     for path in paths:
-        print(row(path))
+        print(make_row(path))
 
 
 if __name__ == "__main__":

@@ -19,6 +19,7 @@
 #include "stokescontact/lcp/bbpgd.hpp"
 #include "stokescontact/lcp/minimum_map_newton.hpp"
 #include "stokescontact/lcp/model_started_newton.hpp"
+#include "stokescontact/contact/solvers/defect_correction.hpp"
 
 // The whole file in its own namespace: tests of one layer are compiled together (unity build).
 namespace lcp_solvers_tests {
@@ -571,6 +572,98 @@ TEST(LcpSolvers, PreconditionedNewtonSolvesALargeClusterInFewApplications) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("preconditioner"), std::string::npos) << e.what();
   }
+}
+
+// Once a direction of a solve has needed the factorisation, Newton's later directions with a
+// new set A factorise at once (minimum_map_newton.hpp). The lattice cluster from lambda = 10 on
+// every pair (most of them must let go, so the set A changes): 3 factorisations and 171
+// applications of A; with 50 unpreconditioned steps before each factorisation, 275 (measured
+// with the rule removed); factorising from the first Arnoldi step, 51. Unpreconditioned, it
+// reports no factorisation.
+TEST(LcpSolvers, NewtonFactorisesAtOnceAfterTheFirstDirectionThatNeedsIt) {
+  const LatticeCluster lattice;
+  const SparseMat& A = lattice.A;
+  const sc::VecX& b = lattice.b;
+  const sc::VecX pushed = sc::VecX::Constant(b.size(), 10.0);
+  sc::LcpOptions options{.tolerance = 1e-8, .max_iterations = 200};
+  const sc::LcpResult learnt = sc::solve_lcp_minimum_map_newton(A, b, options, &pushed, &A);
+  const sc::LcpResult plain = sc::solve_lcp_minimum_map_newton(A, b, options, &pushed);
+  options.gmres_unpreconditioned_steps = 0;
+  const sc::LcpResult at_once = sc::solve_lcp_minimum_map_newton(A, b, options, &pushed, &A);
+  for (const sc::LcpResult* r : {&learnt, &plain, &at_once}) ASSERT_TRUE(r->converged) << r->residual;
+  std::printf("  lattice cluster from lambda = 10: %zu applications (%d factorisations) with 50 unpreconditioned "
+              "steps first, %zu (%d) factorising at once\n",
+              learnt.operator_applications, learnt.preconditioner_factorisations, at_once.operator_applications,
+              at_once.preconditioner_factorisations);
+  EXPECT_GE(learnt.preconditioner_factorisations, 2);
+  EXPECT_LE(learnt.operator_applications, 220u);
+  EXPECT_EQ(plain.preconditioner_factorisations, 0);
+  const double scale = std::max(1.0, plain.gamma.cwiseAbs().maxCoeff());
+  EXPECT_LE((learnt.gamma - plain.gamma).cwiseAbs().maxCoeff(), 1e-6 * scale);
+}
+
+// A non-symmetric sparse A (the lattice cluster's Laplacian with a skew coupling between
+// neighbouring pairs, as the Jacobian of turning rods departs from the model at Q*):
+// preconditioned by the sparse LU of its own active blocks, Newton takes fewer applications
+// than preconditioned by LDLT of the symmetric cluster (the model at Q*), for the same
+// solution. IterateJacobianModel asks for that LU only where A departs from its base by more
+// than kLuDeparture.
+TEST(LcpSolvers, NewtonPreconditionedByTheLuOfANonSymmetricMatrix) {
+  const LatticeCluster lattice;
+  const SparseMat& P = lattice.A;
+  const sc::VecX& b = lattice.b;
+  SparseMat skew(P.rows(), P.cols());
+  {
+    std::vector<Eigen::Triplet<double>> entries;
+    for (Eigen::Index c = 0; c < P.outerSize(); ++c)
+      for (SparseMat::InnerIterator it(P, c); it; ++it)
+        if (it.row() < c) {  // +0.4 above the diagonal, -0.4 below, on P's pattern
+          entries.emplace_back(it.row(), c, 0.4);
+          entries.emplace_back(c, it.row(), -0.4);
+        }
+    skew.setFromTriplets(entries.begin(), entries.end());
+  }
+  const SparseMat A = P + skew;
+  const sc::LcpOptions options{.tolerance = 1e-8, .max_iterations = 200};
+  const sc::LcpResult by_model = sc::solve_lcp_minimum_map_newton(A, b, options, nullptr, &P);
+  const sc::LcpResult by_lu = sc::solve_lcp_minimum_map_newton(A, b, options, nullptr, &A, false);
+  ASSERT_TRUE(by_model.converged) << by_model.residual;
+  ASSERT_TRUE(by_lu.converged) << by_lu.residual;
+  std::printf("  skewed lattice cluster: %zu applications preconditioned by LDLT of the symmetric part, %zu by the "
+              "LU of A\n",
+              by_model.operator_applications, by_lu.operator_applications);
+  EXPECT_LT(2 * by_lu.operator_applications, by_model.operator_applications);
+  EXPECT_GE(by_lu.preconditioner_factorisations, 1);
+  const double scale = std::max(1.0, by_model.gamma.cwiseAbs().maxCoeff());
+  EXPECT_LE((by_lu.gamma - by_model.gamma).cwiseAbs().maxCoeff(), 1e-6 * scale);
+
+  const sc::detail::IterateJacobianModel far{P, A};
+  EXPECT_EQ(far.lu_preconditioner(), &far.A);
+  const sc::detail::IterateJacobianModel near{P, SparseMat(P + 0.01 * skew)};
+  EXPECT_EQ(near.lu_preconditioner(), nullptr);
+}
+
+// The default solver's working-set LCP learns the same across a round's corrections: after a
+// correction's Newton needed its factorisation, the next ones factorise at once
+// (defect_correction.hpp, WorkingSetLcp); a block that converges unpreconditioned does not
+// teach it that.
+TEST(LcpSolvers, WorkingSetLcpFactorisesAtOnceAfterACorrectionThatNeededIt) {
+  const LatticeCluster lattice;
+  const Eigen::Index c = lattice.b.size();
+  std::vector<Eigen::Index> W(static_cast<std::size_t>(c));
+  for (Eigen::Index k = 0; k < c; ++k) W[static_cast<std::size_t>(k)] = k;
+  const sc::VecX zero = sc::VecX::Zero(c);
+  const sc::detail::WorkingSetLcp lcp{sc::LcpOptions{.tolerance = 1e-8, .max_iterations = 200}};
+  // d - target = b with lambda = 0: the lattice's LCP
+  ASSERT_TRUE(lcp(lattice.A, W, zero, sc::VecX(lattice.b + sc::VecX::Ones(c)), 1.0, {}).has_value());
+  EXPECT_TRUE(lcp.factorise_at_once);
+
+  const sc::MatX dense = (sc::MatX(3, 3) << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0).finished();
+  const SparseMat small = dense.sparseView();
+  const std::vector<Eigen::Index> three{0, 1, 2};
+  const sc::detail::WorkingSetLcp easy{sc::LcpOptions{1e-12}};
+  ASSERT_TRUE(easy(small, three, sc::VecX::Zero(3), sc::VecX::Zero(3), 1.0, {}).has_value());
+  EXPECT_FALSE(easy.factorise_at_once);
 }
 
 // The lattice cluster as the LCP sequence solves it when the default solver hands it a round

@@ -41,7 +41,8 @@ struct LcpOptions {
   double regularization = 1e-2;    // proximal term mu_k = regularization c |H_k| / |H_0| (0: none)
   // With a sparse preconditioner: Arnoldi steps a Newton direction takes before its block is
   // factorised (0: at once, where a product with A costs a mobility application and a sparse
-  // factorisation is cheaper than a few of them).
+  // factorisation is cheaper than a few of them). After the first direction of a solve that
+  // needed the factorisation, the later ones factorise at once (minimum_map_newton.hpp).
   int gmres_unpreconditioned_steps = 50;
   // Newton: Armijo halvings per line search; APGD: doublings of L per step.
   int max_line_search_steps = 40;
@@ -78,6 +79,7 @@ struct LcpResult {
   std::size_t operator_applications = 0;  // every application of A, inner GMRES ones included
   double residual = 0.0;                  // ||min(gamma, w)||_inf / ||b||_inf (0 when b = 0)
   bool converged = false;                 // residual <= tolerance
+  int preconditioner_factorisations = 0;  // sparse factorisations of a preconditioner (Newton)
 };
 
 // ||min(gamma, w)||_inf: the max norm of the minimum map (Yan eq. 44, Lu eq. 62); 0 when empty.

@@ -15,10 +15,15 @@
 // correction; or A itself) passes it: GMRES is then right-preconditioned by a sparse Cholesky
 // factorisation (Eigen's SimplicialLDLT) of P_AA + mu_k I, so that a large connected cluster,
 // whose A conditions like a graph Laplacian, costs a few Arnoldi steps per direction instead
-// of hundreds. A direction first gets LcpOptions::gmres_unpreconditioned_steps (50) Arnoldi
+// of hundreds. A non-symmetric P (A itself, where A is a sparse Jacobian far from symmetric) is
+// factorised by sparse LU instead. A direction first gets LcpOptions::gmres_unpreconditioned_steps (50) Arnoldi
 // steps without it (a well-conditioned block, e.g. a model lifted by a diagonal shift,
 // converges in those, and a factorisation would cost more than it saves); only then is P_AA + mu_k I factorised, and
-// GMRES goes on from where it stopped. The factorisation is kept while the set A stays the
+// GMRES goes on from where it stopped. Once one direction of a solve has needed the
+// factorisation, the solve's later directions with a new set A factorise at once: their blocks
+// are the same problem's, and 50 more unpreconditioned steps on each made the default solver's
+// corrections on dense Brownian rods 1.15-1.45x slower (docs/results.md, "The working-set LCP's
+// factorisations"). The factorisation is kept while the set A stays the
 // same (mu_k changes, but a preconditioner need not be exact: GMRES's residual is the true
 // one). Where that block is not positive definite, GMRES runs unpreconditioned. The proximal term
 // mu_k = regularization c |H_k| / |H_0| (Levenberg-Marquardt style) keeps the block solvable
@@ -54,6 +59,7 @@
 #include <vector>
 
 #include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
 
 #include "stokescontact/lcp/lcp.hpp"
 #include "stokescontact/core/gmres.hpp"
@@ -102,33 +108,54 @@ inline Eigen::SparseMatrix<double> shifted_principal_block(const Eigen::SparseMa
   return block;
 }
 
-// (P_AA + mu I)^-1 for Newton's GMRES, factorised again only when the set A changes.
+// (P_AA + mu I)^-1 for Newton's GMRES, factorised again only when the set A changes: by LDLT
+// where P is symmetric, by sparse LU (Eigen's SparseLU, COLAMD ordering) where it is not.
 class ActiveBlockPreconditioner {
  public:
-  explicit ActiveBlockPreconditioner(const Eigen::SparseMatrix<double>* P) : P_(P) {}
+  ActiveBlockPreconditioner(const Eigen::SparseMatrix<double>* P, bool symmetric) : P_(P), symmetric_(symmetric) {}
 
   bool available() const { return P_ != nullptr; }
   // Whether it is already that of `active`.
   bool factorised_for(const std::vector<Eigen::Index>& active) const { return factorised_ && active == active_; }
+  // Whether a direction of this solve has needed the factorisation (of any set A).
+  bool factorised_before() const { return factorisations_ > 0; }
+  int factorisations() const { return factorisations_; }
 
   // Makes the preconditioner that of `active` (mu: the shift when it must be factorised).
   void update(const std::vector<Eigen::Index>& active, double mu) {
     if (P_ == nullptr || (factorised_ && active == active_)) return;
     active_ = active;
     factorised_ = true;
-    factor_.emplace(shifted_principal_block(*P_, active, mu));
-    // LDLT also factorises indefinite blocks: only a positive diagonal makes it a preconditioner
-    // of the positive definite A_AA + mu I that GMRES solves.
-    if (factor_->info() != Eigen::Success || !(factor_->vectorD().minCoeff() > 0.0)) factor_.reset();
+    ++factorisations_;
+    factor_.reset();
+    lu_.reset();
+    Eigen::SparseMatrix<double> block = shifted_principal_block(*P_, active, mu);
+    if (symmetric_) {
+      factor_.emplace(block);
+      // LDLT also factorises indefinite blocks: only a positive diagonal makes it a preconditioner
+      // of the positive definite A_AA + mu I that GMRES solves.
+      if (factor_->info() != Eigen::Success || !(factor_->vectorD().minCoeff() > 0.0)) factor_.reset();
+    } else {
+      block.makeCompressed();
+      lu_.emplace(block);  // a singular block: no preconditioner
+      if (lu_->info() != Eigen::Success) lu_.reset();
+    }
   }
 
-  VecX operator()(const VecX& v) const { return factor_ ? VecX(factor_->solve(v)) : v; }
+  VecX operator()(const VecX& v) const {
+    if (factor_) return factor_->solve(v);
+    if (lu_) return lu_->solve(v);
+    return v;
+  }
 
  private:
   const Eigen::SparseMatrix<double>* P_;
+  bool symmetric_;
   std::vector<Eigen::Index> active_;
   bool factorised_ = false;
+  int factorisations_ = 0;
   std::optional<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> factor_;
+  std::optional<Eigen::SparseLU<Eigen::SparseMatrix<double>>> lu_;
 };
 
 // Alg. 2 line 7 on the reduced system: d_F = -lambda_F, (A_AA + mu I) d_A = -y_A - A_AF d_F by
@@ -167,7 +194,9 @@ MinimumMapDirection newton_direction(Op& A, const MinimumMapState& s, const VecX
     GmresResult solved;
     if (preconditioner.available() && !preconditioner.factorised_for(active)) {
       GmresOptions quick = gmres_options;
-      quick.max_iterations = std::min(quick.max_iterations, options.gmres_unpreconditioned_steps);
+      quick.max_iterations = preconditioner.factorised_before()
+                                 ? 0
+                                 : std::min(quick.max_iterations, options.gmres_unpreconditioned_steps);
       if (quick.max_iterations == 0) {
         preconditioner.update(active, mu);
         solved = gmres(A_AA, rhs, preconditioner, gmres_options);
@@ -239,12 +268,15 @@ inline bool stalled(const std::vector<double>& best_psi, int window) {
 
 }  // namespace detail
 
-// `preconditioner`, when given: a sparse symmetric matrix close to A (same size), whose
-// principal blocks precondition the Newton directions' GMRES (see the top of this file).
+// `preconditioner`, when given: a sparse matrix close to A (same size), whose principal blocks
+// precondition the Newton directions' GMRES (see the top of this file); symmetric, or not
+// (`preconditioner_symmetric` false: factorised by sparse LU, e.g. A itself where A is a
+// non-symmetric sparse matrix).
 template <LcpMatrixOperator ApplyA>
 LcpResult solve_lcp_minimum_map_newton(ApplyA&& apply_A, const VecX& b, const LcpOptions& options = {},
                                        const VecX* warm_start = nullptr,
-                                       const Eigen::SparseMatrix<double>* preconditioner = nullptr) {
+                                       const Eigen::SparseMatrix<double>* preconditioner = nullptr,
+                                       bool preconditioner_symmetric = true) {
   detail::LcpSolve<std::remove_reference_t<ApplyA>> solve(apply_A, b, options, warm_start);
   if (preconditioner != nullptr && (preconditioner->rows() != b.size() || preconditioner->cols() != b.size()))
     fail_argument("preconditioner", "is " + std::to_string(preconditioner->rows()) + " x " +
@@ -267,14 +299,18 @@ LcpResult solve_lcp_minimum_map_newton(ApplyA&& apply_A, const VecX& b, const Lc
   const double threshold = options.tolerance * solve.b_scale;  // on ||min(gamma, w)||_inf
   const double H0_norm = detail::scaled_minimum_map(s.lambda, s.y, c).norm();
   double eta_cap = options.forcing_max;
-  detail::ActiveBlockPreconditioner block_preconditioner(preconditioner);
+  detail::ActiveBlockPreconditioner block_preconditioner(preconditioner, preconditioner_symmetric);
+  const auto finish = [&](int iterations) {
+    LcpResult out = solve.finish(std::move(s.lambda), std::move(s.y), iterations, s.y_exact);
+    out.preconditioner_factorisations = block_preconditioner.factorisations();
+    return out;
+  };
   std::vector<double> best_psi;  // the least merit up to each Newton step, for the stall window
   int k = 0;
   for (;;) {
     if (solve.converged(s.lambda, s.y)) {
       project();
-      if (solve.confirmed_converged(s.lambda, s.y, s.y_exact))
-        return solve.finish(std::move(s.lambda), std::move(s.y), k);
+      if (solve.confirmed_converged(s.lambda, s.y, s.y_exact)) return finish(k);
     }
     if (k == options.max_iterations) break;
     ++k;
@@ -301,7 +337,7 @@ LcpResult solve_lcp_minimum_map_newton(ApplyA&& apply_A, const VecX& b, const Lc
       break;  // stalled: no step decreases psi
   }
   project();
-  return solve.finish(std::move(s.lambda), std::move(s.y), k, s.y_exact);
+  return finish(k);
 }
 
 }  // namespace stokescontact

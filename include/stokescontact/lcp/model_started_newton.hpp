@@ -20,11 +20,16 @@ namespace stokescontact {
 inline constexpr LcpOptions kGradientStart{1e-3, 200};  // BBPGD's start for minimum-map Newton
 
 // 0 <= gamma _|_ A gamma + b >= 0 from `warm` (b_P: the same LCP's b for P, so that
-// P gamma + b_P ~ A gamma + b near warm).
+// P gamma + b_P ~ A gamma + b near warm). `lu_preconditioner`, when given, a non-symmetric sparse
+// matrix closer to A than P (A itself, where A is sparse), preconditions GMRES in P's place,
+// factorised by sparse LU.
 template <LcpMatrixOperator ApplyA>
 LcpResult solve_lcp_newton_from_model(ApplyA&& A, const VecX& b, const Eigen::SparseMatrix<double>& P,
-                                      const VecX& b_P, const LcpOptions& options, const VecX& warm) {
+                                      const VecX& b_P, const LcpOptions& options, const VecX& warm,
+                                      const Eigen::SparseMatrix<double>* lu_preconditioner = nullptr) {
   const VecX start = solve_lcp_bbpgd(P, b_P, kGradientStart, &warm).gamma;
+  if (lu_preconditioner != nullptr)
+    return solve_lcp_minimum_map_newton(A, b, options, &start, lu_preconditioner, false);
   return solve_lcp_minimum_map_newton(A, b, options, &start, &P);
 }
 

@@ -249,13 +249,25 @@ inline Eigen::SparseMatrix<double> positive_definite(const Eigen::SparseMatrix<d
 
 // The working-set model of DefectCorrectionOptions::jacobian_at_iterate: A = dt D_k^T M D on W,
 // not symmetric; base() is the symmetric model at Q* (positive definite), from which Newton
-// starts and by which it is preconditioned (solve_working_set_lcp).
+// starts (solve_working_set_lcp). Newton's GMRES is preconditioned by base() where A is close
+// to it, and by the sparse LU of A's own active blocks where A departs from it by more than
+// kLuDeparture (||A - base()||_F / ||base()||_F): rods that turn under their contact forces,
+// whose GMRES preconditioned by base() took most of a correction's time. Measured on the
+// working sets of the default solver's LCPs: 400 Brownian rods L/D = 5 at eta 0.45, 0.075-0.44
+// (median 0.31); 1000 spheres driven into a ball or jammed, 4e-5-0.015 (median 1.5e-3), where
+// LDLT of base() is the cheaper factorisation of an as good preconditioner (docs/results.md,
+// "The working-set LCP's factorisations").
 struct IterateJacobianModel {
+  static constexpr double kLuDeparture = 0.03;
   const Eigen::SparseMatrix<double>& symmetric;
   Eigen::SparseMatrix<double> A;
 
   const Eigen::SparseMatrix<double>& base() const { return symmetric; }
   VecX operator()(const VecX& x) const { return A * x; }
+  const Eigen::SparseMatrix<double>* lu_preconditioner() const {
+    const double scale = symmetric.norm();
+    return scale > 0.0 && (A - symmetric).norm() > kLuDeparture * scale ? &A : nullptr;
+  }
 };
 
 // dt D_k^T (M D) on the working set W, D_k at the evaluated iterate e; M D sparse (blocks mode).
@@ -269,10 +281,12 @@ Eigen::SparseMatrix<double> iterate_jacobian(const ContactStep<S, M>& step, cons
 
 // The working set's LCP of the linear model about the current iterate (A: the model on W, a
 // matrix or an operator; distances: all flagged pairs at the iterate); the new lambda on all
-// pairs, none if the LCP solver did not converge.
+// pairs, none if the LCP solver did not converge. `factorisations`, when given, receives the
+// sparse factorisations Newton's preconditioner made (LcpResult::preconditioner_factorisations).
 template <LcpMatrixOperator Model>
 std::optional<VecX> solve_working_set_lcp(const Model& A, std::span<const Eigen::Index> W, const VecX& lambda,
-                                          const VecX& distances, double target, const LcpOptions& options) {
+                                          const VecX& distances, double target, const LcpOptions& options,
+                                          int* factorisations = nullptr) {
   const auto n = static_cast<Eigen::Index>(W.size());
   VecX lambda_W(n), d_W(n);
   for (Eigen::Index r = 0; r < n; ++r) {
@@ -289,22 +303,26 @@ std::optional<VecX> solve_working_set_lcp(const Model& A, std::span<const Eigen:
     return next;
   };
   // Where there is a sparse model (or the sparse matrix a secant correction corrects), Newton
-  // starts from BBPGD on it and is preconditioned by it (model_started_newton.hpp). A
+  // starts from BBPGD on it and is preconditioned by it (model_started_newton.hpp), or by the
+  // model's own LU where it asks for that (IterateJacobianModel::lu_preconditioner). A
   // secant-corrected model is not symmetric, and BB steps on it can diverge: its sparse part
   // is used instead.
   const Eigen::SparseMatrix<double>* sparse_part = nullptr;
   if constexpr (std::is_same_v<Model, Eigen::SparseMatrix<double>>) sparse_part = &A;
   else if constexpr (requires { { A.base() } -> std::same_as<const Eigen::SparseMatrix<double>&>; })
     sparse_part = &A.base();
-  if (!sparse_part) {
-    const LcpResult lcp = solve_lcp_minimum_map_newton(A, b, options, &lambda_W);
+  const auto answer = [&](const LcpResult& lcp) {
+    if (factorisations) *factorisations = lcp.preconditioner_factorisations;
     return lcp.converged ? std::optional<VecX>(scatter(lcp.gamma)) : std::nullopt;
-  }
+  };
+  if (!sparse_part) return answer(solve_lcp_minimum_map_newton(A, b, options, &lambda_W));
   const VecX b_sparse = std::is_same_v<Model, Eigen::SparseMatrix<double>>
                             ? b
                             : VecX(d_W - VecX::Constant(n, target) - *sparse_part * lambda_W);
-  const LcpResult lcp = solve_lcp_newton_from_model(A, b, *sparse_part, b_sparse, options, lambda_W);
-  return lcp.converged ? std::optional<VecX>(scatter(lcp.gamma)) : std::nullopt;
+  const Eigen::SparseMatrix<double>* lu_preconditioner = nullptr;
+  if constexpr (requires { { A.lu_preconditioner() } -> std::same_as<const Eigen::SparseMatrix<double>*>; })
+    lu_preconditioner = A.lu_preconditioner();
+  return answer(solve_lcp_newton_from_model(A, b, *sparse_part, b_sparse, options, lambda_W, lu_preconditioner));
 }
 
 // What the round tells the problem of one correction: its number in the round and how far to
@@ -325,16 +343,25 @@ inline double correction_lcp_tolerance(const DefectCorrectionOptions& options, d
 // poses it: the LCP above (Broms eq. 27, complementarity), to the correction's tolerance. The
 // round takes any callable of this shape (barrier_working_set.hpp poses eq. 15 instead);
 // `name` prefixes its messages.
+// Once a correction's Newton has needed its sparse preconditioner (GMRES did not converge in
+// LcpOptions::gmres_unpreconditioned_steps), the round's later corrections factorise at once:
+// their working sets are the same clusters, and the unpreconditioned steps would be spent again
+// on each (docs/results.md, "The working-set LCP's factorisations").
 struct WorkingSetLcp {
   LcpOptions options;
   std::string_view name = "default solver";
+  mutable bool factorise_at_once = false;  // learnt by the round's corrections, not an input
 
   template <LcpMatrixOperator Model>
   std::optional<VecX> operator()(const Model& A, std::span<const Eigen::Index> W, const VecX& lambda,
                                  const VecX& distances, double target, const Correction& correction) const {
     LcpOptions inexact = options;
     inexact.tolerance = correction.lcp_tolerance;
-    return solve_working_set_lcp(A, W, lambda, distances, target, inexact);
+    if (factorise_at_once) inexact.gmres_unpreconditioned_steps = 0;
+    int factorisations = 0;
+    std::optional<VecX> next = solve_working_set_lcp(A, W, lambda, distances, target, inexact, &factorisations);
+    factorise_at_once = factorise_at_once || factorisations > 0;
+    return next;
   }
 };
 
