@@ -16,16 +16,17 @@
 // factorisation (Eigen's SimplicialLDLT) of P_AA + mu_k I, so that a large connected cluster,
 // whose A conditions like a graph Laplacian, costs a few Arnoldi steps per direction instead
 // of hundreds. A non-symmetric P (A itself, where A is a sparse Jacobian far from symmetric) is
-// factorised by sparse LU instead. A direction first gets LcpOptions::gmres_unpreconditioned_steps (50) Arnoldi
-// steps without it (a well-conditioned block, e.g. a model lifted by a diagonal shift,
-// converges in those, and a factorisation would cost more than it saves); only then is P_AA + mu_k I factorised, and
-// GMRES goes on from where it stopped. Once one direction of a solve has needed the
-// factorisation, the solve's later directions with a new set A factorise at once: their blocks
-// are the same problem's, and 50 more unpreconditioned steps on each made the default solver's
-// corrections on dense Brownian rods 1.15-1.45x slower (docs/results.md, "The working-set LCP's
-// factorisations"). The factorisation is kept while the set A stays the
-// same (mu_k changes, but a preconditioner need not be exact: GMRES's residual is the true
-// one). Where that block is not positive definite, GMRES runs unpreconditioned. The proximal term
+// factorised by sparse LU instead. A direction first gets
+// LcpOptions::gmres_unpreconditioned_steps (50) Arnoldi steps without it (a well-conditioned
+// block, e.g. a model lifted by a diagonal shift, converges in those, and a factorisation would
+// cost more than it saves); only then is P_AA + mu_k I factorised, and GMRES goes on from where
+// it stopped. Once one direction of a solve has needed the factorisation, the solve's later
+// directions with a new set A factorise at once: their blocks are the same problem's, and 50
+// more unpreconditioned steps on each made the default solver's corrections on dense Brownian
+// rods 1.15-1.45x slower (docs/results.md, "The working-set LCP's factorisations"). The
+// factorisation is kept while the set A stays the same (mu_k changes, but a preconditioner
+// need not be exact: GMRES's residual is the true one). Where a symmetric P's block is not
+// positive definite, or a non-symmetric one's is singular, GMRES runs unpreconditioned. The proximal term
 // mu_k = regularization c |H_k| / |H_0| (Levenberg-Marquardt style) keeps the block solvable
 // when more contacts are active than A has rank, and vanishes as H -> 0. GMRES stops at the
 // inexact-Newton tolerance eta_k = min(eta_cap, |H_k| / |H_0|), no tighter than the stopping
@@ -116,16 +117,17 @@ class ActiveBlockPreconditioner {
 
   bool available() const { return P_ != nullptr; }
   // Whether it is already that of `active`.
-  bool factorised_for(const std::vector<Eigen::Index>& active) const { return factorised_ && active == active_; }
+  bool factorised_for(const std::vector<Eigen::Index>& active) const {
+    return factorisations_ > 0 && active == active_;
+  }
   // Whether a direction of this solve has needed the factorisation (of any set A).
   bool factorised_before() const { return factorisations_ > 0; }
   int factorisations() const { return factorisations_; }
 
   // Makes the preconditioner that of `active` (mu: the shift when it must be factorised).
   void update(const std::vector<Eigen::Index>& active, double mu) {
-    if (P_ == nullptr || (factorised_ && active == active_)) return;
+    if (P_ == nullptr || factorised_for(active)) return;
     active_ = active;
-    factorised_ = true;
     ++factorisations_;
     factor_.reset();
     lu_.reset();
@@ -152,7 +154,6 @@ class ActiveBlockPreconditioner {
   const Eigen::SparseMatrix<double>* P_;
   bool symmetric_;
   std::vector<Eigen::Index> active_;
-  bool factorised_ = false;
   int factorisations_ = 0;
   std::optional<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>> factor_;
   std::optional<Eigen::SparseLU<Eigen::SparseMatrix<double>>> lu_;
