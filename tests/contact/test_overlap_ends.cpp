@@ -99,6 +99,45 @@ TEST(OverlapEnds, EndGapsBoundTheOverlapFromBelow) {
   EXPECT_GT(checked, 100);
 }
 
+// Centre line b beside centre line a (1.01 apart at b's p0, b tilted by 0.01 so that the pair
+// is closest at its low side) slid down along a by `slide`: for slide < 0 b's p0 is the
+// overlap's low end, for slide > 0 a's p0 is. The end found at slide = -0.1 (b's p0) measures
+// the gap at the overlap's low end, here the pair's distance (closest_points), through the
+// passage and beyond, continuously: at slide = 0.1 the distance of a's p0 to b's line,
+// (1.01 + 0.01 x 0.1) / sqrt(1 + 0.01^2). b's p0 alone measures the distance of the two rod
+// ends there, sqrt(1.01^2 + 0.1^2): 0.0049 too far, half a d_hat of 0.01. With b's ends
+// swapped (b pointing down) the same.
+TEST(OverlapEnds, EndGapFollowsTheOverlapEndFromOneRodToTheOther) {
+  const double tilt = 0.01, gap = 1.01;
+  const sc::Segment a{sc::Vec3(0, 0, 0), sc::Vec3(0, 0, 5)};
+  const auto b_at = [&](double slide, bool reversed) {
+    const sc::Vec3 p0(gap, 0, -slide), p1(gap + 5 * tilt, 0, 5 - slide);
+    return reversed ? sc::Segment{p1, p0} : sc::Segment{p0, p1};
+  };
+  for (const bool reversed : {false, true}) {
+    const auto ends = sc::overlap_ends(a, b_at(-0.1, reversed), 0.1, 0.1);
+    ASSERT_TRUE(ends);
+    const sc::SegmentEnd low = (*ends)[0];
+    EXPECT_EQ(low.segment, 1);
+    EXPECT_EQ(low.end, reversed ? 1 : 0);
+    double largest_step = 0.0, previous = sc::overlap_end_gap(a, b_at(-0.1, reversed), low).distance;
+    for (int k = -1000; k <= 1000; ++k) {
+      const sc::Segment b = b_at(1e-4 * k, reversed);
+      const double measured = sc::overlap_end_gap(a, b, low).distance;
+      EXPECT_NEAR(measured, sc::closest_points(a, b).distance, 1e-12) << "slide " << 1e-4 * k;
+      largest_step = std::max(largest_step, std::abs(measured - previous));
+      previous = measured;
+    }
+    EXPECT_LT(largest_step, 2e-6);  // continuous: steps of 1e-4 move it by at most tilt x 1e-4
+    const sc::Segment b = b_at(0.1, reversed);
+    EXPECT_NEAR(sc::overlap_end_gap(a, b, low).distance, (gap + tilt * 0.1) / std::sqrt(1 + tilt * tilt), 1e-14);
+    EXPECT_NEAR(sc::end_to_segment(a, b, low).distance, std::sqrt(gap * gap + 0.01), 1e-14);
+    EXPECT_EQ(sc::same_side_end(a, b, low).segment, 0);
+    EXPECT_EQ(sc::same_side_end(a, b, low).end, 0);
+    EXPECT_EQ(sc::same_side_end(a, b, {0, 1}).end, reversed ? 0 : 1);
+  }
+}
+
 namespace {
 
 const sc::Spherocylinder kRod{4.0, 0.5};
@@ -330,6 +369,78 @@ TEST(OverlapEnds, DominoTiltedRodGridStepConverges) {
   EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
   EXPECT_LT(r.lambda_max, 1e3);
   EXPECT_LT(r.max_correction_turn, 0.05);
+}
+
+// Eight rods L/D = 5 of a run of 400 Brownian rods (eta 0.40, dt D_R = 5e-4, overlap-ends
+// directions at 0.3 rad; docs/results.md, "The overlap's end passes from one rod to the
+// other"): the first contact step of the step that no halving separated, cut down (rods removed
+// one at a time from the 128 within 7 of rod 26, as long as the step still failed with the end
+// fixed at Q* and converged with the overlap's end). Rods 26 and 305 are 4.6 degrees apart,
+// side by side with their low ends level. Per rod: pose (centre relative to rod 26, quaternion
+// w x y z) and U (the Brownian velocity, 3 + 3). The trial step crosses the pair near its high
+// ends, the correction slides one rod down along the other, and the overlap's low end passes
+// from rod 305's end to rod 26's. Measured at rod 305's end, as the end found at Q*, the low
+// end's contact held two rod ends apart while rod 26's end closed in on rod 305: the default
+// solver stalled at 0.82 d_hat after 50 corrections, and so did its fallbacks. Measured at the
+// overlap's end: converged in 18 corrections.
+TEST(OverlapEnds, OverlapEndPassingFromOneRodToTheOtherStaysHeld) {
+  const sc::Spherocylinder rod{5.0, 0.5};
+  const double dt = 0.023353384385508973, d_hat = 0.01;
+  const std::vector<std::array<double, 13>> rows{
+      {0, 0, 0,  // rod 26
+       0.99480751564283298, 0.0087893526762981185, 0.098118176669233753, -0.02556516198210455,
+       -2.1334144397720549, 3.7373215348288009, 2.8502665083848311,
+       0.84390995505832989, -2.9775958924957835, -0.98223709958348715},
+      {-2.3984896971677543, -0.21029793789340712, -1.2406997252557268,  // rod 54
+       0.88999712721145996, -0.098715876575201714, 0.05894299308995022, 0.44123237962884815,
+       2.0980505333139003, 1.7551391695446337, -1.1787410740561504,
+       2.3295633750792648, -1.4860085325800712, -0.55343533494342989},
+      {-3.603408200681657, 1.0422331919760088, -0.55703904492009571,  // rod 61
+       0.84488332930704779, 0.1111260731039822, -0.044210783896659799, 0.5214101670688539,
+       -1.9234135108364445, 0.81605071306580201, 0.82862971817465247,
+       -2.1279951325988153, 0.66150021219642774, 2.2467929427588791},
+      {-1.0985532633254476, 1.0409091597530553, -0.64983093325184171,  // rod 96
+       0.99571189338657129, -0.052367040088609422, 0.00019264513103190993, -0.076259303489744537,
+       -4.5951536824068882, -0.0044606989555129404, 0.44563628698275015,
+       -0.6084213223577748, -0.61694960071257376, 0.96594033084572661},
+      {-1.1949355409837352, 1.7859019030348469, 5.7829252482849398,  // rod 97
+       0.88514411796574832, -0.14553202310042845, -0.084599538671791263, -0.43380092063002146,
+       -0.58421916329387269, -0.71463804439138834, -4.7437916255396857,
+       0.62532152824745502, -2.1007940498303768, 0.72268162369729783},
+      {-2.2112930908744453, 0.30168142548531929, -5.1988266264992404,  // rod 98
+       0.95915972279035522, -0.015775007535139038, -0.25264542760835701, -0.12623019932878865,
+       -1.6444512214103542, 0.68319552269941475, 1.9798827254719666,
+       -1.6704255108696164, 1.695989751020716, -0.58373646415870029},
+      {-3.4362048361344337, -0.49862030703249083, -3.5349332408081278,  // rod 145
+       0.97441318942685251, 0.069619218576338571, 0.011868759982243527, -0.21338048929621689,
+       3.9551033636393527, -0.99649915026086888, 2.9835112289175041,
+       1.6508300336928967, -0.14983251860619123, 0.78528699770362509},
+      {-1.013973055812416, 0.057821825450740327, 0.1808601819152944,  // rod 305
+       0.99508079572298125, -0.026477972425535269, 0.092489677615287313, 0.023638665236670502,
+       3.1674126716206508, 5.2862773223359456, 1.1749795398400147,
+       -0.24583747224884672, -0.83862158748951432, -0.37248170162864364},
+  };
+  std::vector<sc::Pose> poses;
+  sc::VecX U(6 * static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const auto& r = rows[k];
+    poses.push_back({sc::Vec3(r[0], r[1], r[2]), sc::Quat(r[3], r[4], r[5], r[6]).normalized()});
+    for (int d = 0; d < 6; ++d) U(6 * static_cast<Eigen::Index>(k) + d) = r[7 + static_cast<std::size_t>(d)];
+  }
+  const std::vector<sc::Spherocylinder> shapes{rod};
+  sc::FreeDrainingMobility mobility(sc::spherocylinder_mobility(rod, 1.0), poses.size(), 6);
+  const sc::ContactStepProblem<sc::Spherocylinder> problem{shapes, poses, U, dt, d_hat, 0.0, 1.0, {}};
+  sc::ContactStepOptions options = overlap_ends();
+  options.overlap_ends_angle = 0.3;
+  const sc::ContactStepResult r = sc::solve_contact_step(problem, mobility, options, sc::ContactSolver{});
+  std::printf("[overlap end passing] %s, %d corrections, %zu contacts, lambda_max %.3g, min d / d_hat %.6f\n",
+              std::string(sc::to_string(r.status)).c_str(), r.iterations, r.pairs.size(), r.lambda_max,
+              r.min_distance_ratio);
+  ASSERT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+  EXPECT_TRUE(r.fallback.empty()) << r.fallback;
+  EXPECT_GE(r.min_distance_ratio, 1.0 - options.separation_margin);
+  EXPECT_LE(r.iterations, 30);
+  EXPECT_LT(r.max_correction_turn, 0.2);
 }
 
 TEST(OverlapEnds, BadOptionsNameTheField) {

@@ -36,8 +36,10 @@ struct ContactPair {
   // a line contact of two LineContactRods (geometry/line_contact.hpp), its distance the gap
   // at those points. `points` keeps d^P, the distance the contact step constrains.
   std::optional<ClosestPoints> force_points;
-  // One end of the overlap of two near-parallel rods (split_overlap_ends): `points` are that
-  // segment end and its closest point on the other rod, the distance constrained their gap.
+  // One end of the overlap of two near-parallel rods (split_overlap_ends): the segment end
+  // that was the overlap's end at Q*. `points` are the overlap's end on its side, where the
+  // pair is now (that end or the other rod's end there, geometry/overlap_ends.hpp's
+  // overlap_end_gap), and its closest point on the other rod; the distance constrained their gap.
   std::optional<SegmentEnd> segment_end;
 };
 
@@ -99,13 +101,14 @@ ContactPair contact_pair(std::span<const S> shapes, std::span<const Pose> poses,
   return pair;
 }
 
-// The contact of segment end e of pair (i, j) at poses: that end's closest points, its gap.
+// The contact of pair (i, j) at poses at the end of their overlap on segment end e's side:
+// the gap there (overlap_end_gap: e's or the other rod's end on that side, the nearer).
 inline ContactPair overlap_end_pair(const Spherocylinder& a, const Pose& pose_a, const Spherocylinder& b,
                                     const Pose& pose_b, Eigen::Index i, Eigen::Index j, const Vec3& image_shift,
                                     SegmentEnd e) {
   const Segment sa = to_world(centre_curve(a).segments[0], pose_a);
   const Segment sb = to_world(centre_curve(b).segments[0], pose_b);
-  const CurveContact c{end_to_segment(sa, sb, e), unit_tangent(sa, 0.0), unit_tangent(sb, 0.0)};
+  const CurveContact c{overlap_end_gap(sa, sb, e), unit_tangent(sa, 0.0), unit_tangent(sb, 0.0)};
   return {i, j, image_shift, finish(c, a.radius, b.radius, pose_a.x, pose_b.x), std::nullopt, e};
 }
 
