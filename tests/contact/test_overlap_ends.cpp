@@ -382,7 +382,7 @@ TEST(OverlapEnds, DominoTiltedRodGridStepConverges) {
 // from rod 305's end to rod 26's. Measured at rod 305's end, as the end found at Q*, the low
 // end's contact held two rod ends apart while rod 26's end closed in on rod 305: the default
 // solver stalled at 0.82 d_hat after 50 corrections, and so did its fallbacks. Measured at the
-// overlap's end: converged in 18 corrections.
+// overlap's end: converged in 18 corrections; and so with the frame shifted by 1e4.
 TEST(OverlapEnds, OverlapEndPassingFromOneRodToTheOtherStaysHeld) {
   const sc::Spherocylinder rod{5.0, 0.5};
   const double dt = 0.023353384385508973, d_hat = 0.01;
@@ -441,6 +441,14 @@ TEST(OverlapEnds, OverlapEndPassingFromOneRodToTheOtherStaysHeld) {
   EXPECT_GE(r.min_distance_ratio, 1.0 - options.separation_margin);
   EXPECT_LE(r.iterations, 30);
   EXPECT_LT(r.max_correction_turn, 0.2);
+  // The frame shifted by 1e4 along every axis: the same step, to rounding.
+  std::vector<sc::Pose> far = poses;
+  for (sc::Pose& p : far) p.x += sc::Vec3::Constant(1e4);
+  const sc::ContactStepProblem<sc::Spherocylinder> shifted{shapes, far, U, dt, d_hat, 0.0, 1.0, {}};
+  const sc::ContactStepResult f = sc::solve_contact_step(shifted, mobility, options, sc::ContactSolver{});
+  ASSERT_EQ(f.status, sc::ContactStepStatus::converged) << f.message;
+  EXPECT_GE(f.min_distance_ratio, 1.0 - options.separation_margin);
+  EXPECT_NEAR(f.lambda_sum, r.lambda_sum, 1e-6 * r.lambda_sum);
 }
 
 TEST(OverlapEnds, BadOptionsNameTheField) {
