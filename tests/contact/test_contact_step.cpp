@@ -758,6 +758,24 @@ TEST(ContactStep, RejectsBadInputNamingTheFieldAndChangesNothing) {
   check([](SphereScene& s, P&, O&) { s.U.resize(5); }, "U");  // p.U refers to s.U
   check([](SphereScene& s, P&, O&) { s.U(2) = INFINITY; }, "U");
   check([](SphereScene& s, P& p, O&) { s.poses[1].x.x() = 1.5; p.poses = s.poses; }, "poses");  // overlap
+  // The same with DTryRule::relative, where only the flagged pairs are measured at Q_t: also
+  // when the pair flies apart in the step (centres 4.5 apart at Q*), and across a periodic side.
+  check([](SphereScene& s, P& p, O&) { s.poses[1].x.x() = 1.5; p.poses = s.poses; p.d_try_rule = sc::DTryRule::relative; },
+        "poses");
+  for (const sc::DTryRule rule : {sc::DTryRule::relative, sc::DTryRule::absolute})
+    check([rule](SphereScene& s, P& p, O&) {
+      s.poses[1].x.x() = 1.5;
+      p.poses = s.poses;
+      s.U << -150, 0, 0, 150, 0, 0;
+      p.d_try_rule = rule;
+    }, "poses");
+  check([](SphereScene& s, P& p, O&) {
+    s.poses[0].x = sc::Vec3(0.2, 5, 5);
+    s.poses[1].x = sc::Vec3(9.7, 5, 5);  // 0.5 apart through the side of the box of side 10
+    p.poses = s.poses;
+    p.box = sc::PeriodicBox{sc::Vec3::Constant(10.0)};
+    p.d_try_rule = sc::DTryRule::relative;
+  }, "poses");
   check([](SphereScene& s, P& p, O&) { s.poses[1].q.w() = 2.0; p.poses = s.poses; }, "poses[1].q");
   check([](SphereScene&, P& p, O&) { p.d_try = 0.5 * p.d_hat; }, "d_try");
   check([](SphereScene&, P& p, O&) { p.d_try_multiplier = 0.5; }, "multiplier");

@@ -325,15 +325,6 @@ class ContactStep {
     require_finite(problem.d_try_multiplier, "d_try_multiplier");
     if (!(problem.d_try_multiplier >= 1.0))
       fail_argument("d_try_multiplier", "must be >= 1, got " + std::to_string(problem.d_try_multiplier));
-    // Contact free: no pair with d^P < 0 among those with d^P <= 0 (a narrow broad phase).
-    std::vector<ContactPair> touching = find_contact_pairs(problem.shapes, problem.poses, 0.0, problem.box, &cells_);
-    const auto deepest = std::min_element(touching.begin(), touching.end(), [](const auto& a, const auto& b) {
-      return a.points.distance < b.points.distance;
-    });
-    if (deepest != touching.end() && deepest->points.distance < 0.0)
-      fail_argument("poses", "Q_t must be contact free; bodies " + std::to_string(deepest->i) + " and " +
-                                 std::to_string(deepest->j) +
-                                 " overlap, d = " + std::to_string(deepest->points.distance));
     d_try_ = problem.d_try;
     if (d_try_ != 0.0) {
       require_positive(d_try_, "d_try");
@@ -354,6 +345,16 @@ class ContactStep {
       RelativePairs found = find_pairs_relative(problem.shapes, trial, problem.U, dofs_, problem.dt, problem.d_hat,
                                                 problem.d_try_multiplier, problem.box, &cells_);
       pairs_ = std::move(found.pairs);
+      // Every pair within d_hat at Q_t is flagged (a pair that comes within d_hat at any time of
+      // the trial step is: continuous_detection.hpp), so Q_t is contact free when the flagged
+      // pairs are there: O(Nc) distances instead of a broad phase over all N bodies at Q_t
+      // (6% of a step of 1e5 free-draining spheres).
+      std::vector<ContactPair> at_start(pairs_.size());
+      parallel_for(nc(), [&](std::ptrdiff_t k) {
+        const ContactPair& p = pairs_[static_cast<std::size_t>(k)];
+        at_start[static_cast<std::size_t>(k)] = detail::contact_pair(problem.shapes, problem.poses, p.i, p.j, problem.box);
+      });
+      require_contact_free(at_start);
       unflagged_stay_clear_ = true;
       // One value where one is needed (the barrier's eps_reg, the d^S node threshold): the largest.
       d_try_ = problem.d_try_multiplier * problem.d_hat;
@@ -363,6 +364,8 @@ class ContactStep {
         d_try_ = dofs_ == 3 ? d_try_spheres(problem.d_hat, problem.dt, problem.U, 3, problem.d_try_multiplier)
                             : d_try_tip_velocity(problem.d_hat, problem.dt, problem.shapes, problem.poses, problem.U,
                                                  problem.d_try_multiplier);
+      // Contact free: no pair with d^P < 0 among those with d^P <= 0 at Q_t (a narrow broad phase).
+      require_contact_free(find_contact_pairs(problem.shapes, problem.poses, 0.0, problem.box, &cells_));
       pairs_ = find_contact_pairs(problem.shapes, trial, d_try_, problem.box, &cells_);
     }
     if (cost_ == MobilityCost::automatic)
@@ -723,6 +726,16 @@ class ContactStep {
   std::size_t applications() const { return mobility_.applications() - start_applications_; }
 
  private:
+  // Q_t must be contact free: `touching` holds every pair of Q_t that could overlap, measured there.
+  static void require_contact_free(const std::vector<ContactPair>& touching) {
+    const auto deepest = std::min_element(touching.begin(), touching.end(), [](const auto& a, const auto& b) {
+      return a.points.distance < b.points.distance;
+    });
+    if (deepest != touching.end() && deepest->points.distance < 0.0)
+      fail_argument("poses", "Q_t must be contact free; bodies " + std::to_string(deepest->i) + " and " +
+                                 std::to_string(deepest->j) + " overlap, d = " + std::to_string(deepest->points.distance));
+  }
+
   // Pairs are only ever appended (after the constructor's first call): the columns of D, the
   // columns of M D already formed and the measurements at Q* of the pairs before stay valid,
   // so only the new pairs' are computed (in parallel) and appended to D and, in blocks mode,
