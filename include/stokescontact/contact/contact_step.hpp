@@ -349,12 +349,14 @@ class ContactStep {
       // the trial step is: continuous_detection.hpp), so Q_t is contact free when the flagged
       // pairs are there: O(Nc) distances instead of a broad phase over all N bodies at Q_t
       // (6% of a step of 1e5 free-draining spheres).
-      std::vector<ContactPair> at_start(pairs_.size());
+      // (Their distances only: at 1e6 spheres, 3e5 pairs held whole would be ~80 MB per step.)
+      std::vector<double> at_start(pairs_.size());
       parallel_for(nc(), [&](std::ptrdiff_t k) {
         const ContactPair& p = pairs_[static_cast<std::size_t>(k)];
-        at_start[static_cast<std::size_t>(k)] = detail::contact_pair(problem.shapes, problem.poses, p.i, p.j, problem.box);
+        at_start[static_cast<std::size_t>(k)] =
+            detail::contact_pair(problem.shapes, problem.poses, p.i, p.j, problem.box).points.distance;
       });
-      require_contact_free(at_start);
+      require_contact_free(pairs_, at_start);
       unflagged_stay_clear_ = true;
       // One value where one is needed (the barrier's eps_reg, the d^S node threshold): the largest.
       d_try_ = problem.d_try_multiplier * problem.d_hat;
@@ -365,7 +367,10 @@ class ContactStep {
                             : d_try_tip_velocity(problem.d_hat, problem.dt, problem.shapes, problem.poses, problem.U,
                                                  problem.d_try_multiplier);
       // Contact free: no pair with d^P < 0 among those with d^P <= 0 at Q_t (a narrow broad phase).
-      require_contact_free(find_contact_pairs(problem.shapes, problem.poses, 0.0, problem.box, &cells_));
+      const std::vector<ContactPair> touching = find_contact_pairs(problem.shapes, problem.poses, 0.0, problem.box, &cells_);
+      std::vector<double> at_start(touching.size());
+      for (std::size_t k = 0; k < touching.size(); ++k) at_start[k] = touching[k].points.distance;
+      require_contact_free(touching, at_start);
       pairs_ = find_contact_pairs(problem.shapes, trial, d_try_, problem.box, &cells_);
     }
     if (cost_ == MobilityCost::automatic)
@@ -726,14 +731,14 @@ class ContactStep {
   std::size_t applications() const { return mobility_.applications() - start_applications_; }
 
  private:
-  // Q_t must be contact free: `touching` holds every pair of Q_t that could overlap, measured there.
-  static void require_contact_free(const std::vector<ContactPair>& touching) {
-    const auto deepest = std::min_element(touching.begin(), touching.end(), [](const auto& a, const auto& b) {
-      return a.points.distance < b.points.distance;
-    });
-    if (deepest != touching.end() && deepest->points.distance < 0.0)
-      fail_argument("poses", "Q_t must be contact free; bodies " + std::to_string(deepest->i) + " and " +
-                                 std::to_string(deepest->j) + " overlap, d = " + std::to_string(deepest->points.distance));
+  // Q_t must be contact free: `pairs` hold every pair of Q_t that could overlap, `d` their
+  // distances there.
+  static void require_contact_free(const std::vector<ContactPair>& pairs, const std::vector<double>& d) {
+    const auto deepest = std::min_element(d.begin(), d.end());
+    if (deepest == d.end() || !(*deepest < 0.0)) return;
+    const ContactPair& p = pairs[static_cast<std::size_t>(deepest - d.begin())];
+    fail_argument("poses", "Q_t must be contact free; bodies " + std::to_string(p.i) + " and " + std::to_string(p.j) +
+                               " overlap, d = " + std::to_string(*deepest));
   }
 
   // Pairs are only ever appended (after the constructor's first call): the columns of D, the
