@@ -10,7 +10,8 @@
 // Per N and cost mode: the unconstrained step (M at Q_t, U = M f and Q* = Q_t + dt U), the
 // contact step (detection, solve and the whole-step guarantee), flagged and pushed pairs,
 // mobility applications, solver iterations, status, min d / d_hat after, sphere-steps per
-// second of the contact step and the process's peak resident memory so far (sizes run in the
+// second of the contact step, its time by phase (ContactStepResult::phase_times: medians over
+// the repeats, phase by phase) and the process's peak resident memory so far (sizes run in the
 // order given). Formed mode runs only up to --formed-max bodies: it forms one column of M D per
 // working-set pair, O(N) each. blocks (the library's automatic choice for free draining) forms
 // M D sparsely from the bodies' blocks: no application. --max-memory-mb > 0: ERROR when the
@@ -131,6 +132,7 @@ int run(const Options& o) {
       sc::FreeDrainingMobility mobility(sc::sphere_mobility(shapes[0], 1.0), n, 3);
       sc::VecX U;
       std::vector<double> unconstrained_times, contact_times;
+      std::vector<sc::ContactStepPhaseTimes> phases;
       for (int k = 0; k < o.repeat; ++k) {
         const auto start = std::chrono::steady_clock::now();
         mobility.set_configuration(packing.poses);
@@ -146,6 +148,7 @@ int run(const Options& o) {
         const auto start = std::chrono::steady_clock::now();
         sc::ContactStepResult again = sc::solve_contact_step(problem, mobility, options, solver);
         contact_times.push_back(seconds_since(start));
+        phases.push_back(again.phase_times);
         if (k > 0 && (again.lambda != r.lambda || again.status != r.status)) {
           std::printf("ERROR: N = %zu, %s: repeat %d of the same step gave other forces\n", n, cost_name.c_str(), k);
           ok = false;
@@ -153,6 +156,17 @@ int run(const Options& o) {
         r = std::move(again);
       }
       const double unconstrained_s = median(unconstrained_times), contact_s = median(contact_times);
+      const auto phase_median = [&phases](double sc::ContactStepPhaseTimes::*phase) {
+        std::vector<double> v;
+        for (const sc::ContactStepPhaseTimes& p : phases) v.push_back(p.*phase);
+        return median(v);
+      };
+      const double setup_s = phase_median(&sc::ContactStepPhaseTimes::setup_s),
+                   solve_s = phase_median(&sc::ContactStepPhaseTimes::solve_s),
+                   end_s = phase_median(&sc::ContactStepPhaseTimes::end_check_s),
+                   interior_s = phase_median(&sc::ContactStepPhaseTimes::interior_check_s),
+                   add_s = phase_median(&sc::ContactStepPhaseTimes::add_pairs_s),
+                   finish_s = phase_median(&sc::ContactStepPhaseTimes::finish_s);
       const auto pushed = static_cast<std::size_t>((r.lambda.array() > 0.0).count());
       const double memory = peak_memory_mb();
       const double rate = static_cast<double>(n) / contact_s;
@@ -168,12 +182,18 @@ int run(const Options& o) {
                 std::to_string(r.guarantee_rounds) + ", \"min_d_over_d_hat_after\": " +
                 sc::json_number(r.min_distance_ratio) + ", \"status\": \"" + std::string(sc::to_string(r.status)) +
                 "\", \"sphere_steps_per_s\": " + sc::json_number(rate) + ", \"peak_memory_mb\": " +
-                sc::json_number(memory) + "}");
+                sc::json_number(memory) + ", \"phases_s\": {\"setup\": " + sc::json_number(setup_s) +
+                ", \"solve\": " + sc::json_number(solve_s) + ", \"end_check\": " + sc::json_number(end_s) +
+                ", \"interior_check\": " + sc::json_number(interior_s) + ", \"add_pairs\": " +
+                sc::json_number(add_s) + ", \"finish\": " + sc::json_number(finish_s) + "}}");
       std::printf("%9zu %11s | %9.4fs | %9.4fs %9.4fs %6.0f | %7zu %7zu | %5zu %4d | %9.6f | %10.3g | %8.0f | %s\n", n,
                   cost_name.c_str(), unconstrained_s, contact_s, contact_times.front(), contact_s / unconstrained_s,
                   r.flagged_pairs, pushed,
                   r.mobility_applications, r.iterations, r.min_distance_ratio, rate, memory,
                   std::string(sc::to_string(r.status)).c_str());
+      std::printf("%21s   phases (medians): setup %.4fs, solve %.4fs, end check %.4fs, interior check %.4fs, "
+                  "added pairs %.4fs, result %.4fs\n",
+                  "", setup_s, solve_s, end_s, interior_s, add_s, finish_s);
       std::fflush(stdout);
       if (r.status != sc::ContactStepStatus::converged) {
         std::printf("ERROR: N = %zu, %s: %s\n", n, cost_name.c_str(), r.message.c_str());

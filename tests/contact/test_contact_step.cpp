@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -400,6 +401,40 @@ TEST(ContactStep, GuaranteeLoopCatchesPairsTheTrialStepMissed) {
     EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
     expect_third_law(r, 3);
   }
+}
+
+// ContactStepResult::phase_times: each phase of run_contact_step lands in its own field, they
+// add up to the wall time, and a stopwatch around the call bounds that.
+TEST(ContactStep, PhaseTimesSplitTheWallTime) {
+  const SphereScene missed = chain();  // the trial step misses a pair: one guarantee round
+  for (const bool whole_step : {true, false}) {
+    SCOPED_TRACE(whole_step ? "whole step" : "end only");
+    sc::ContactStepOptions options;
+    options.whole_step = whole_step;
+    auto m = missed.mobility();
+    const auto start = std::chrono::steady_clock::now();
+    const sc::ContactStepResult r = run(Solver::kDefault, missed.problem(), m, options);
+    const double outside = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const sc::ContactStepPhaseTimes& t = r.phase_times;
+    ASSERT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+    ASSERT_GE(r.guarantee_rounds, 1);
+    EXPECT_NEAR(t.total(), r.wall_time_s, 1e-12);
+    EXPECT_LE(r.wall_time_s, outside);
+    EXPECT_GT(t.setup_s, 0.0);
+    EXPECT_GT(t.solve_s, 0.0);
+    EXPECT_GT(t.end_check_s, 0.0);
+    EXPECT_GT(t.add_pairs_s, 0.0);
+    EXPECT_GT(t.finish_s, 0.0);
+    if (whole_step) EXPECT_GT(t.interior_check_s, 0.0);
+    else EXPECT_EQ(t.interior_check_s, 0.0);  // no interior check was made
+  }
+  // Nothing missed: no time in adding pairs.
+  const SphereScene s = head_on(0.1, 20.0);
+  auto m = s.mobility();
+  const sc::ContactStepResult r = run(Solver::kDefault, s.problem(), m);
+  ASSERT_EQ(r.guarantee_rounds, 0);
+  EXPECT_EQ(r.phase_times.add_pairs_s, 0.0);
+  EXPECT_GT(r.phase_times.interior_check_s, 0.0);
 }
 
 TEST(ContactStep, GuaranteeFailureIsReportedNotHidden) {

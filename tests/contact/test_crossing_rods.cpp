@@ -161,6 +161,8 @@ TEST(CrossingRods, DefaultSolverFallsBackToTheNearRoot) {
     EXPECT_EQ(r.lambda, near.lambda);
     EXPECT_GE(r.iterations, near.iterations + 1);
     EXPECT_LT(r.max_correction_turn, 0.5);
+    // The wall time and its phases count both solves.
+    EXPECT_NEAR(r.phase_times.total(), r.wall_time_s, 1e-12);
 
     // In time: one contact step, no sub-step, and the diagnostics count the fallback.
     sc::TimeStepperOptions o;

@@ -205,6 +205,28 @@ constexpr std::string_view to_string(ContactStepStatus status) {
   return "unknown";
 }
 
+// Where a contact step's wall time went, phase by phase of run_contact_step (seconds). The
+// phases follow one another, so they add up to wall_time_s (to rounding).
+struct ContactStepPhaseTimes {
+  double setup_s = 0.0;           // ContactStep: Q_t's check, detection at Q*, D's columns, M D
+  double solve_s = 0.0;           // the solver's rounds (the default solver's early end check is in it)
+  double end_check_s = 0.0;       // Q(lambda) and the query for pairs below d_hat at the end
+  double interior_check_s = 0.0;  // trajectory_crossings along the corrected motion (whole_step)
+  double add_pairs_s = 0.0;       // guarantee rounds: the missed pairs' columns and measurements
+  double finish_s = 0.0;          // the result: forces, velocities, min d^P, energies, residuals
+
+  double total() const { return setup_s + solve_s + end_check_s + interior_check_s + add_pairs_s + finish_s; }
+  ContactStepPhaseTimes& operator+=(const ContactStepPhaseTimes& o) {
+    setup_s += o.setup_s;
+    solve_s += o.solve_s;
+    end_check_s += o.end_check_s;
+    interior_check_s += o.interior_check_s;
+    add_pairs_s += o.add_pairs_s;
+    finish_s += o.finish_s;
+    return *this;
+  }
+};
+
 // The same result for every solver.
 struct ContactStepResult {
   ContactStepStatus status = ContactStepStatus::converged;
@@ -221,6 +243,7 @@ struct ContactStepResult {
   std::size_t mobility_applications = 0;
   MobilityCost cost = MobilityCost::formed;  // the cost mode used (automatic resolved)
   double wall_time_s = 0.0;
+  ContactStepPhaseTimes phase_times;    // wall_time_s by phase
   double d_try = 0.0;                   // the threshold used
   double min_distance_ratio = 0.0;      // min d^P over all pairs of Q(lambda) / d_hat (inf: < 2 bodies)
   double barrier_energy = 0.0;          // sum b(d_k) over flagged pairs at Q(lambda), eq. 10 with eps_reg = d_try
@@ -990,9 +1013,16 @@ inline VecX padded(const VecX& lambda, Eigen::Index size) {
 template <Shape S, MobilityOperator M, typename Solve>
 ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobility,
                                    const ContactStepOptions& options, Solve&& solve) {
-  const auto start = std::chrono::steady_clock::now();
-  ContactStep<S, M> step(problem, mobility, options);
+  auto lap_start = std::chrono::steady_clock::now();
+  const auto lap = [&lap_start](double& phase) {  // the time since the last lap, into `phase`
+    const auto now = std::chrono::steady_clock::now();
+    phase += std::chrono::duration<double>(now - lap_start).count();
+    lap_start = now;
+  };
   ContactStepResult r;
+  ContactStepPhaseTimes& t = r.phase_times;
+  ContactStep<S, M> step(problem, mobility, options);
+  lap(t.setup_s);
   ContactSolveOutcome outcome;
   std::vector<ContactPair> violating;
   // The smallest d^P of the last Q(lambda) checked, when its end query held it (NaN: not known).
@@ -1005,6 +1035,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   for (int round = 0;; ++round) {
     const int iterations = r.iterations;
     outcome = solve(step, detail::padded(outcome.lambda, step.nc()));
+    lap(t.solve_s);
     r.iterations = iterations + outcome.iterations;
     r.guarantee_rounds = round;
     const ContactEvaluation& e = step.evaluate(outcome.lambda);
@@ -1022,6 +1053,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
       for (const ContactPair& p : violating) end_minimum = std::min(end_minimum, p.points.distance);
     }
     std::erase_if(violating, [&](const ContactPair& p) { return step.separated(p.points.distance); });
+    lap(t.end_check_s);
     // The interior: no overlap along the corrected motion.
     const VecX V = problem.U + e.MD_lambda;
     if (options.whole_step) {
@@ -1039,8 +1071,10 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
                                         &step.cells(), scope ? &*scope : nullptr);
       } catch (const MotionBeyondBox& e) {  // forces that fling a body: not a motion to check or keep
         beyond_box = e.what();
+        lap(t.interior_check_s);
         break;
       }
+      lap(t.interior_check_s);
     }
     if ((violating.empty() && crossing.empty()) || round == options.max_guarantee_rounds) break;
     // A round whose solver did not converge and left one of its own flagged pairs overlapping
@@ -1062,6 +1096,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
                          [&](const ContactPair& p) { return p.i == c.i && p.j == c.j; });
     });
     const std::size_t added = step.add_pairs(violating) + step.add_crossings(inside, V);
+    lap(t.add_pairs_s);
     if (added == 0) break;
   }
   const ContactEvaluation& e = step.evaluate(outcome.lambda);
@@ -1113,7 +1148,8 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   r.pairs = std::move(step).release_pairs();  // the step is finished: e is not used below
   r.columns = std::move(step).release_columns();
   r.poses = std::move(step).release_last_poses();
-  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  lap(t.finish_s);
+  r.wall_time_s = t.total();
   return r;
 }
 

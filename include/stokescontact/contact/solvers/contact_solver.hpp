@@ -178,9 +178,9 @@ inline std::string trimmed(std::string message) {
 //  - any failure by the LCP sequence (lcp-newton: exact products, no probing, no ray search),
 //    whose LCPs hold contact networks where the corrections stall.
 // Each solve starts afresh (its probes cost again). The result counts the applications,
-// iterations and wall time of every solve; its `fallback` names the solver whose answer it is
-// (empty: every fallback failed too, and the default solver's failure is returned, with
-// theirs in its message).
+// iterations and wall time (and its phases) of every solve; its `fallback` names the solver
+// whose answer it is (empty: every fallback failed too, and the default solver's failure is
+// returned, with theirs in its message).
 template <Shape S, MobilityOperator M>
 ContactStepResult solve_failed_step_again(const ContactStepProblem<S>& problem, M& mobility,
                                           const ContactStepOptions& options, const DefectCorrectionOptions& solver,
@@ -188,11 +188,13 @@ ContactStepResult solve_failed_step_again(const ContactStepProblem<S>& problem, 
   std::size_t applications = failed.mobility_applications;
   int iterations = failed.iterations;
   double wall_time_s = failed.wall_time_s;
+  ContactStepPhaseTimes phase_times = failed.phase_times;
   std::string tried;
   const auto attempt = [&](std::string_view name, ContactStepResult again) -> std::optional<ContactStepResult> {
     applications += again.mobility_applications;
     iterations += again.iterations;
     wall_time_s += again.wall_time_s;
+    phase_times += again.phase_times;
     if (again.status == ContactStepStatus::failed_separation) {
       tried += "; " + std::string(name) + ", tried on this step: " + trimmed(again.message);
       return std::nullopt;
@@ -200,6 +202,7 @@ ContactStepResult solve_failed_step_again(const ContactStepProblem<S>& problem, 
     again.mobility_applications = applications;
     again.iterations = iterations;
     again.wall_time_s = wall_time_s;
+    again.phase_times = phase_times;
     again.fallback = name;
     again.message = "solved again by " + std::string(name) + " after the default solver's " + trimmed(failed.message) +
                     (again.message.empty() ? std::string() : "; " + std::string(name) + ": " + again.message);
@@ -224,6 +227,7 @@ ContactStepResult solve_failed_step_again(const ContactStepProblem<S>& problem, 
   failed.mobility_applications = applications;
   failed.iterations = iterations;
   failed.wall_time_s = wall_time_s;
+  failed.phase_times = phase_times;
   failed.message = trimmed(failed.message) + tried;
   return failed;
 }
