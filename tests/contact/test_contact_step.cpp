@@ -590,6 +590,44 @@ TEST(ContactStep, DenseSceneWithSmallDTryIsSeparatedByTheGuaranteeLoop) {
   }
 }
 
+// A hyperstatic cluster: a block of 3 x 3 x 3 face-centred cubic cells (172 spheres), every
+// neighbour pair at d_hat / 2, at rest: more pairs below d_hat than the spheres have degrees of
+// freedom, so the exact working-set model dt D^T M D is singular (the default solver uses an
+// exact model as it is and lifts it to positive definite only when its LCPs fail). The step
+// expands the block until every pair is at d_hat.
+TEST(ContactStep, HyperstaticClusterWithASingularExactModelIsSeparated) {
+  SphereScene s;
+  const double d_hat = 0.01, a = std::sqrt(2.0) * (2.0 + 0.5 * d_hat);  // nearest neighbours at d_hat / 2
+  const int cells = 3;
+  const std::vector<sc::Vec3> basis{{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
+  for (int i = 0; i <= cells; ++i)
+    for (int j = 0; j <= cells; ++j)
+      for (int k = 0; k <= cells; ++k)
+        for (const sc::Vec3& b : basis) {
+          const sc::Vec3 x = a * (sc::Vec3(i, j, k) + b);
+          if ((x.array() <= a * cells + 1e-9).all()) s.poses.push_back({x, sc::Quat::Identity()});
+        }
+  const auto n = static_cast<Eigen::Index>(s.poses.size());
+  ASSERT_EQ(n, 172);
+  s.U = sc::VecX::Zero(3 * n);
+  s.d_hat = d_hat;
+  auto m = s.mobility();
+  const sc::ContactStepProblem<sc::Sphere> problem{s.shapes, s.poses, s.U, s.dt, s.d_hat};
+  const sc::ContactStepResult r = sc::solve_contact_step_defect_correction(problem, m);
+  EXPECT_EQ(r.status, sc::ContactStepStatus::converged) << r.message;
+  EXPECT_EQ(r.cost, sc::MobilityCost::blocks);
+  const auto pushed = (r.lambda.array() > 0.0).count();
+  std::printf("hyperstatic cluster: Nc %zu pushed %ld corrections %d min d / d_hat %.6f sum lambda %.6g\n",
+              r.flagged_pairs, static_cast<long>(pushed), r.iterations, r.min_distance_ratio, r.lambda_sum);
+  EXPECT_GT(pushed, 3 * n);  // more columns than rows in D: D^T M D is singular
+  // The exact model is the step's linearisation: one correction (lifted at once, as every model
+  // was before, 3 corrections and the same sum of lambda to 6 digits).
+  EXPECT_LE(r.iterations, 1);
+  EXPECT_GE(r.min_distance_ratio, 1.0 - 1e-3);
+  EXPECT_LE(r.min_distance_ratio, 1.0 + 1e-3);
+  expect_third_law(r, 3);
+}
+
 // A jammed cluster (100 spheres compressed to packing 0.55, scenes/sphere_packing.hpp, d_hat =
 // the smallest gap, random |f| = 100): hundreds of flagged pairs in one connected network,
 // where the working set's smallest sum can leave complementarity (pairs pushed that end

@@ -31,7 +31,8 @@
 //  - from the second correction on, each measured step (delta lambda, delta d) corrects A~ by
 //    a multisecant update (secant_update.hpp); the memory is dropped when a correction makes
 //    the worst shortfall grow (line contacts of near-parallel rods);
-//  - A~ is lifted to positive definite where probing errors leave it indefinite;
+//  - A~ is lifted to positive definite where probing errors leave it indefinite; an exact model
+//    (blocks, formed) is used as it is, and lifted only when its LCPs fail;
 //  - where probes are shared and two corrections in a row fail to halve the shortfall (large
 //    dense clusters, whose many far fields add up), the round is finished by the LCP sequence
 //    with exact products, polished to complementarity (lcp_sequence.hpp).
@@ -229,6 +230,9 @@ inline MatX positive_definite(const MatX& A, double floor = 1e-3) {
   return eigen.eigenvectors() * values.cwiseMax(smallest).asDiagonal() * eigen.eigenvectors().transpose();
 }
 
+inline Eigen::SparseMatrix<double> lifted_positive_definite(const Eigen::SparseMatrix<double>& A, double floor,
+                                                            Eigen::Index dense_limit);
+
 // The same lift for a sparse A~ (the probed model): up to `dense_limit` rows the nearest
 // matrix above (dense); beyond, where an eigendecomposition costs O(n^3) (seconds at 1000), the shift
 // A~ + tau I with tau = floor x (Gershgorin's bound on the largest eigenvalue), quadrupled
@@ -237,6 +241,13 @@ inline Eigen::SparseMatrix<double> positive_definite(const Eigen::SparseMatrix<d
                                                      Eigen::Index dense_limit = 200) {
   using Sparse = Eigen::SparseMatrix<double>;
   if (A.rows() == 0 || Eigen::SimplicialLLT<Sparse>(A).info() == Eigen::Success) return A;
+  return lifted_positive_definite(A, floor, dense_limit);
+}
+
+// positive_definite's lift of a sparse A~ that is not positive definite (no check that it is).
+inline Eigen::SparseMatrix<double> lifted_positive_definite(const Eigen::SparseMatrix<double>& A, double floor,
+                                                            Eigen::Index dense_limit) {
+  using Sparse = Eigen::SparseMatrix<double>;
   if (A.rows() <= dense_limit) return positive_definite(MatX(A), floor).sparseView();
   const VecX row_sums = A.cwiseAbs() * VecX::Ones(A.cols());
   Sparse identity(A.rows(), A.cols());
@@ -248,7 +259,7 @@ inline Eigen::SparseMatrix<double> positive_definite(const Eigen::SparseMatrix<d
 }
 
 // The working-set model of DefectCorrectionOptions::jacobian_at_iterate: A = dt D_k^T M D on W,
-// not symmetric; base() is the symmetric model at Q* (positive definite), from which Newton
+// not symmetric; base() is the symmetric model at Q* (positive semi-definite), from which Newton
 // starts (solve_working_set_lcp). Newton's GMRES is preconditioned by base() where A is close
 // to it, and by the sparse LU of A's own active blocks where A departs from it by more than
 // kLuDeparture (||A - base()||_F / ||base()||_F): rods that turn under their contact forces,
@@ -579,7 +590,16 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
     joining.push_back(k);
   };
   VecX previous_lambda, previous_distances;
-  Eigen::SparseMatrix<double> probed;  // positive_definite(probing.matrix()), recomputed when W grows
+  // The model on W, recomputed when W grows: positive_definite(probing.matrix()) when probed
+  // (matrix-free: probing errors can make it indefinite). An exact model (blocks, formed:
+  // dt D_W^T M D_W from exact columns) is positive semi-definite by construction and is used
+  // as it is; it is lifted (lifted_positive_definite) only when the LCPs on it fail, which a
+  // singular one (more contacts than degrees of freedom) may make them. The sparse Cholesky
+  // factorisation that checks a model for the lift was 15-30% of the step on jammed packings
+  // of 1000 spheres (docs/results.md, "The exact model is not checked").
+  Eigen::SparseMatrix<double> probed;
+  const bool exact_model = !std::isfinite(radius);
+  bool probed_lifted = false;  // probed is positive_definite's answer
   double previous_shortfall = std::numeric_limits<double>::infinity();
   double best_shortfall = std::numeric_limits<double>::infinity();
   VecX best_lambda = lambda, best_MD, best_distances;  // best_MD: M D best_lambda
@@ -669,15 +689,29 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       const std::vector<Eigen::Index>& W = probing.members();
       // The secant-corrected model is not symmetric; should its LCP fail, the probed one (made
       // positive definite) is a strictly convex QP.
-      if (probed.rows() != static_cast<Eigen::Index>(W.size())) probed = positive_definite(probing.matrix());
+      if (probed.rows() != static_cast<Eigen::Index>(W.size())) {
+        probed = exact_model ? probing.matrix() : positive_definite(probing.matrix());
+        probed_lifted = !exact_model;
+      }
       // The Jacobian at the iterate need not be a P-matrix (its LCP may have no solution):
-      // then the secant-corrected model, then the probed one.
+      // then the secant-corrected model, then the probed one; an exact model that was not
+      // positive definite is then lifted, and the three tried again.
       std::optional<VecX> solved;
-      if (at_iterate && lambda.sum() > 0.0)
-        solved = subproblem(IterateJacobianModel{probed, iterate_jacobian(step, e, W)}, W, lambda, e.distances, target,
-                            correction);
-      if (!solved) solved = subproblem(secant.corrected(probed, W), W, lambda, e.distances, target, correction);
-      if (!solved) solved = subproblem(probed, W, lambda, e.distances, target, correction);
+      const auto solve_on_models = [&] {
+        if (at_iterate && lambda.sum() > 0.0)
+          solved = subproblem(IterateJacobianModel{probed, iterate_jacobian(step, e, W)}, W, lambda, e.distances,
+                              target, correction);
+        if (!solved) solved = subproblem(secant.corrected(probed, W), W, lambda, e.distances, target, correction);
+        if (!solved) solved = subproblem(probed, W, lambda, e.distances, target, correction);
+      };
+      solve_on_models();
+      if (!solved && !probed_lifted) {
+        probed_lifted = true;
+        if (Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>(probed).info() != Eigen::Success) {
+          probed = lifted_positive_definite(probed, 1e-3, 200);
+          solve_on_models();
+        }
+      }
       if (!solved) {
         out.message = std::string(subproblem.name) + ": the working-set problem (" + std::to_string(W.size()) +
                       " pairs) was not solved";
