@@ -590,15 +590,18 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
     joining.push_back(k);
   };
   VecX previous_lambda, previous_distances;
-  // The model on W, recomputed when W grows: positive_definite(probing.matrix()) when probed
-  // (matrix-free: probing errors can make it indefinite). An exact model (blocks, formed:
-  // dt D_W^T M D_W from exact columns) is positive semi-definite by construction and is used
-  // as it is; it is lifted (lifted_positive_definite) only when the LCPs on it fail, which a
-  // singular one (more contacts than degrees of freedom) may make them. The sparse Cholesky
-  // factorisation that checks a model for the lift was 15-30% of the step on jammed packings
-  // of 1000 spheres (docs/results.md, "The exact model is not checked").
+  // The model on W, recomputed when W grows: positive_definite(probing.matrix()). An exact
+  // model of bodies that only translate (spheres in blocks and formed modes: dt D_W^T M D_W
+  // from exact columns) is positive semi-definite by construction and is used as it is; it is
+  // lifted (lifted_positive_definite) only when the LCPs on it fail, which a singular one (more
+  // contacts than degrees of freedom) may make them. The sparse Cholesky factorisation that
+  // checks a model for the lift was 15-30% of the step on jammed packings of 1000 spheres
+  // (docs/results.md, "The exact model is not checked"). Bodies that turn keep the check: the
+  // exact models of dense rods are mostly not positive definite (534 lifts in 40 steps of 400
+  // rods at eta 0.45), and used as they are, the first of those steps failed at step 3 with
+  // a pair at 0.985 d_hat after 50 corrections, where the lifted models ran all 40.
   Eigen::SparseMatrix<double> probed;
-  const bool exact_model = !std::isfinite(radius);
+  const bool exact_model = !std::isfinite(radius) && step.dofs_per_body() == 3;
   bool probed_lifted = false;  // probed is positive_definite's answer
   double previous_shortfall = std::numeric_limits<double>::infinity();
   double best_shortfall = std::numeric_limits<double>::infinity();
