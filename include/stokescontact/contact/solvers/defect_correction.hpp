@@ -32,7 +32,7 @@
 //    a multisecant update (secant_update.hpp); the memory is dropped when a correction makes
 //    the worst shortfall grow (line contacts of near-parallel rods);
 //  - A~ is lifted to positive definite where probing errors leave it indefinite; an exact model
-//    (blocks, formed) is used as it is, and lifted only when its LCPs fail;
+//    of spheres (blocks, formed) is used as it is, and lifted only when its LCPs fail;
 //  - where probes are shared and two corrections in a row fail to halve the shortfall (large
 //    dense clusters, whose many far fields add up), the round is finished by the LCP sequence
 //    with exact products, polished to complementarity (lcp_sequence.hpp).
@@ -230,8 +230,8 @@ inline MatX positive_definite(const MatX& A, double floor = 1e-3) {
   return eigen.eigenvectors() * values.cwiseMax(smallest).asDiagonal() * eigen.eigenvectors().transpose();
 }
 
-inline Eigen::SparseMatrix<double> lifted_positive_definite(const Eigen::SparseMatrix<double>& A, double floor,
-                                                            Eigen::Index dense_limit);
+inline Eigen::SparseMatrix<double> lifted_positive_definite(const Eigen::SparseMatrix<double>& A,
+                                                            double floor = 1e-3, Eigen::Index dense_limit = 200);
 
 // The same lift for a sparse A~ (the probed model): up to `dense_limit` rows the nearest
 // matrix above (dense); beyond, where an eigendecomposition costs O(n^3) (seconds at 1000), the shift
@@ -691,7 +691,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       probing.add(step, joining);
       const std::vector<Eigen::Index>& W = probing.members();
       // The secant-corrected model is not symmetric; should its LCP fail, the probed one (made
-      // positive definite) is a strictly convex QP.
+      // positive definite, at once or, an exact model, below) is a strictly convex QP.
       if (probed.rows() != static_cast<Eigen::Index>(W.size())) {
         probed = exact_model ? probing.matrix() : positive_definite(probing.matrix());
         probed_lifted = !exact_model;
@@ -711,7 +711,7 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       if (!solved && !probed_lifted) {
         probed_lifted = true;
         if (Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>(probed).info() != Eigen::Success) {
-          probed = lifted_positive_definite(probed, 1e-3, 200);
+          probed = lifted_positive_definite(probed);
           solve_on_models();
         }
       }
