@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <optional>
 #include <ostream>
 #include <random>
@@ -149,6 +151,125 @@ TEST(BroadPhase, MatchesBruteForcePeriodicAcrossTheBoundary) {
     const double radius = 0.5 * u(rng) + 0.01;
     expect_matches_brute_force(reused, x, VecX::Constant(n, radius), 0.3 * u(rng), PeriodicBox{length});
   }
+}
+
+// Kept candidates (CellList::keep_candidates) answer every query as brute force does: queries
+// of moved bodies (small moves, a few large ones, a common drift across the periodic seam),
+// grown and shrunk radii, other cutoffs, marked bodies, the bodies reordered; open space far
+// from the origin and periodic. Some answers must come from the kept pairs and some afresh,
+// or the test would not test the reuse.
+TEST(BroadPhase, KeptCandidatesAnswerAsBruteForce) {
+  for (const bool periodic : {false, true}) {
+    SCOPED_TRACE(periodic ? "periodic" : "open, centred at 1e4");
+    std::mt19937_64 rng(periodic ? 71 : 72);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const Eigen::Index n = 600;
+    const double side = cube_side(n, 0.5, 0.3);
+    const Box box = periodic ? Box(PeriodicBox{Vec3::Constant(side)}) : Box();
+    const Vec3 origin = periodic ? Vec3::Zero() : Vec3::Constant(1e4);
+    const Mat3X x0 = uniform_in(rng, n, origin, origin + Vec3::Constant(side));
+    VecX r0(n);
+    for (Eigen::Index i = 0; i < n; ++i) r0[i] = 0.3 + 0.4 * u(rng);
+    CellList kept;
+    kept.keep_candidates(0.3);
+    EXPECT_EQ(kept.find_pairs(x0, r0, 0.05, box), brute_force(x0, r0, 0.05, box));
+    EXPECT_FALSE(kept.last_query_reused());
+    int reused = 0, fresh = 0;
+    for (int trial = 0; trial < 120; ++trial) {
+      SCOPED_TRACE("trial " + std::to_string(trial));
+      // Moves of up to `reach`, a few bodies of up to 3, a common drift; radii within +-0.02.
+      const double reach = 0.06 * u(rng);
+      Mat3X x = x0;
+      VecX r = r0;
+      const Vec3 drift = trial % 3 == 0 ? Vec3(side * u(rng), 2.0, -5.0) : Vec3::Zero();
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const Vec3 direction = Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5).normalized();
+        x.col(i) += drift + reach * u(rng) * direction;
+        r[i] += 0.04 * (u(rng) - 0.5) * (trial % 2);
+      }
+      if (trial % 5 == 1)
+        for (int k = 0; k < 3; ++k) x.col(static_cast<Eigen::Index>(u(rng) * n)) += Vec3(3.0 * u(rng), 0.0, 0.0);
+      if (trial % 7 == 2) {  // the same numbers for other bodies: columns reordered
+        std::vector<Eigen::Index> order(static_cast<std::size_t>(n));
+        std::iota(order.begin(), order.end(), Eigen::Index{0});
+        std::shuffle(order.begin(), order.end(), rng);
+        const Mat3X y = x;
+        const VecX s = r;
+        for (Eigen::Index i = 0; i < n; ++i) {
+          x.col(i) = y.col(order[static_cast<std::size_t>(i)]);
+          r[i] = s[order[static_cast<std::size_t>(i)]];
+        }
+      }
+      const double cutoff = 0.15 * u(rng);
+      const std::vector<BodyPair> expected = brute_force(x, r, cutoff, box);
+      if (trial % 4 == 3) {
+        std::vector<char> marked(static_cast<std::size_t>(n));
+        for (char& m : marked) m = u(rng) < 0.1;
+        std::vector<BodyPair> with_marked;
+        for (const BodyPair& p : expected)
+          if (marked[static_cast<std::size_t>(p.i)] || marked[static_cast<std::size_t>(p.j)]) with_marked.push_back(p);
+        EXPECT_EQ(kept.find_pairs_of(x, r, cutoff, box, marked), with_marked);
+      } else {
+        EXPECT_EQ(kept.find_pairs(x, r, cutoff, box), expected);
+      }
+      (kept.last_query_reused() ? reused : fresh) += 1;
+    }
+    EXPECT_GT(reused, 20);
+    EXPECT_GT(fresh, 20);
+  }
+}
+
+// The bound is tight: pairs just beyond the kept reach (gap C + 1e-3 at the reference) move
+// straight at each other by delta each. Up to delta = (C - c) / 2 none comes within c and the
+// kept pairs answer; beyond, pairs come within c and the query must collect afresh.
+TEST(BroadPhase, KeptCandidatesAtTheEdgeOfTheSkin) {
+  const double radius = 0.5, skin = 0.3, reference_cutoff = 0.05, cutoff = 0.02;
+  const double kept_reach = reference_cutoff + skin;  // C
+  const Eigen::Index pairs = 50;
+  Mat3X x0(3, 2 * pairs);
+  for (Eigen::Index k = 0; k < pairs; ++k) {
+    x0.col(2 * k) = Vec3(10.0 * static_cast<double>(k), 1e4, -1e4);
+    x0.col(2 * k + 1) = x0.col(2 * k) + Vec3(2.0 * radius + kept_reach + 1e-3, 0.0, 0.0);
+  }
+  const VecX r = VecX::Constant(2 * pairs, radius);
+  for (const double excess : {-0.01, -1e-4, 1e-3, 0.01, 0.05}) {
+    SCOPED_TRACE("delta - (C - c) / 2 = " + std::to_string(excess));
+    CellList kept;
+    kept.keep_candidates(skin);
+    ASSERT_TRUE(kept.find_pairs(x0, r, reference_cutoff).empty());
+    const double delta = 0.5 * (kept_reach - cutoff) + excess;
+    Mat3X x = x0;
+    for (Eigen::Index k = 0; k < pairs; ++k) {
+      x(0, 2 * k) += delta;
+      x(0, 2 * k + 1) -= delta;
+    }
+    const std::vector<BodyPair> expected = brute_force(x, r, cutoff, {});
+    EXPECT_EQ(kept.find_pairs(x, r, cutoff), expected);
+    EXPECT_EQ(expected.empty(), excess < 5e-4);
+    EXPECT_EQ(kept.last_query_reused(), excess < 0.0);
+  }
+}
+
+// A subset of the bodies (fewer columns) collects afresh; keep_candidates(0) stops keeping.
+TEST(BroadPhase, KeptCandidatesNeedTheSameBodyCount) {
+  std::mt19937_64 rng(73);
+  const Eigen::Index n = 300;
+  const double side = cube_side(n, 0.5, 0.3);
+  const Mat3X x = uniform_in(rng, n, Vec3::Zero(), Vec3::Constant(side));
+  const VecX r = VecX::Constant(n, 0.5);
+  CellList kept;
+  kept.keep_candidates(0.2);
+  kept.find_pairs(x, r, 0.1);
+  EXPECT_EQ(kept.find_pairs(x, r, 0.1), brute_force(x, r, 0.1, {}));
+  EXPECT_TRUE(kept.last_query_reused());
+  const Mat3X head = x.leftCols(n - 1);
+  EXPECT_EQ(kept.find_pairs(head, r.head(n - 1), 0.1), brute_force(head, r.head(n - 1), 0.1, {}));
+  EXPECT_FALSE(kept.last_query_reused());
+  kept.keep_candidates(0.0);
+  kept.find_pairs(x, r, 0.1);
+  EXPECT_EQ(kept.find_pairs(x, r, 0.1), brute_force(x, r, 0.1, {}));
+  EXPECT_FALSE(kept.last_query_reused());
+  EXPECT_THROW(kept.keep_candidates(-1.0), std::invalid_argument);
 }
 
 // Sides of 1, 2 and 3 cells (and mixed) are where a naive periodic stencil counts twice.

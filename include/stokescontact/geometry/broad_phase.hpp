@@ -66,8 +66,36 @@ inline bool is_candidate_pair(const Vec3& xi, const Vec3& xj, double ri, double 
 // cells folds onto itself (cell index mod buckets, neighbours taken cyclically), so far
 // outliers cost no memory and only add a few rejected checks. Each pair of neighbouring
 // buckets is visited once, so each body pair is tested once. Buffers persist across calls.
+//
+// Kept candidates (a Verlet list): after keep_candidates(skin), a query over all bodies that
+// cannot answer from kept candidates collects its pairs at cutoff + skin, keeps them with its
+// positions x0 and radii r0 as the reference, and answers with those within its own cutoff.
+// A later query (x, r, cutoff c) with as many bodies in the same space answers from the kept
+// pairs, filtered by the same predicate, when no pair can be missing: a pair within reach at
+// x has |x0_i - x0_j| <= |x_i - x_j| + delta_i + delta_j <= r0_i + r0_j + c + g_i + g_j, with
+// delta_k = |x_k - x0_k - s| for any common shift s (the mean displacement: a shift changes
+// no distance, also on the torus) and g_k = delta_k + r_k - r0_k; so c + g_(1) + g_(2) (the
+// two largest) within the reference cutoff C = cutoff + skin, less a rounding allowance,
+// means every such pair was kept. The answer is then the cell list's own, pair for pair.
+// The bound is about the numbers given, not about which body they describe: it holds for
+// any query, whatever its bodies (a subset, reordered), and a query that fails it collects
+// afresh. O(N + kept pairs) instead of a bucket sort and the buckets' checks.
 class CellList {
  public:
+  // Keep candidates within `skin` beyond each full query's cutoff for later queries (see
+  // above); 0 stops keeping them. Drops the kept reference.
+  void keep_candidates(double skin) {
+    require_non_negative(skin, "skin");
+    skin_ = skin;
+    forget_candidates();
+  }
+  void forget_candidates() {
+    kept_.clear();
+    kept_count_ = -1;
+  }
+  // Whether the last query answered from kept candidates.
+  bool last_query_reused() const { return reused_; }
+
   // All candidate pairs (i < j), lexicographically sorted; valid until the next call.
   const std::vector<BodyPair>& find_pairs(const Mat3X& positions, const VecX& radii, double cutoff,
                                           const std::optional<PeriodicBox>& box = {}) {
@@ -102,23 +130,97 @@ class CellList {
   // find_pairs (marked: none) or find_pairs_of.
   const std::vector<BodyPair>& query(const Mat3X& positions, const VecX& radii, double cutoff,
                                      const std::optional<PeriodicBox>& box, const std::span<const char>* marked) {
-    const double range = validate(positions, radii, cutoff, box);
+    double range = validate(positions, radii, cutoff, box);
     for (std::vector<BodyPair>& found : found_) found.clear();  // kept with their capacity
     pairs_.clear();
     pair_checks_ = 0;
+    reused_ = false;
+    if (positions.cols() < 2) {
+      n_ = {0, 0, 0};
+      return pairs_;
+    }
+    if (covered_by_kept(positions, radii, cutoff, box)) {
+      filter_kept(positions, radii, cutoff, box, marked);
+      reused_ = true;
+      return pairs_;
+    }
     n_ = {0, 0, 0};
-    if (positions.cols() < 2) return pairs_;
+    // A full query keeps a new reference, if its reach fits the box.
+    const double kept_cutoff = cutoff + skin_;
+    const bool keep = skin_ > 0.0 && !marked && (!box || range + skin_ <= 0.5 * box->lengths.minCoeff());
+    if (keep) range += skin_;
     build(positions, radii, range, box);
+    const double collect_cutoff = keep ? kept_cutoff : cutoff;
     const Vec3 length = box ? box->lengths : Vec3::Zero();
     if (marked) {
-      if (box) collect_marked<true>(cutoff, length, *marked);
-      else collect_marked<false>(cutoff, length, *marked);
+      if (box) collect_marked<true>(collect_cutoff, length, *marked);
+      else collect_marked<false>(collect_cutoff, length, *marked);
     } else {
-      if (box) collect<true>(cutoff, length);
-      else collect<false>(cutoff, length);
+      if (box) collect<true>(collect_cutoff, length);
+      else collect<false>(collect_cutoff, length);
     }
     sort_pairs(positions.cols());
+    if (keep) {
+      kept_.swap(pairs_);
+      kept_x_ = positions;
+      kept_r_ = radii;
+      kept_cutoff_ = kept_cutoff;
+      kept_box_ = box;
+      kept_count_ = positions.cols();
+      filter_kept(positions, radii, cutoff, box, nullptr);
+    }
     return pairs_;
+  }
+
+  // Whether the kept reference holds every pair of this query (the bound above).
+  bool covered_by_kept(const Mat3X& x, const VecX& r, double cutoff, const std::optional<PeriodicBox>& box) const {
+    if (kept_count_ != x.cols() || box.has_value() != kept_box_.has_value()) return false;
+    if (box && box->lengths != kept_box_->lengths) return false;
+    const Vec3 shift = (x - kept_x_).rowwise().mean();
+    double g1 = -std::numeric_limits<double>::infinity(), g2 = g1, scale = kept_cutoff_ + cutoff;
+    for (Eigen::Index k = 0; k < x.cols(); ++k) {
+      const double g = (x.col(k) - kept_x_.col(k) - shift).norm() + (r[k] - kept_r_[k]);
+      if (g > g2) {
+        g2 = std::min(g, g1);
+        g1 = std::max(g, g1);
+      }
+      scale = std::max({scale, x.col(k).cwiseAbs().maxCoeff(), kept_x_.col(k).cwiseAbs().maxCoeff(), r[k], kept_r_[k]});
+    }
+    if (box) scale = std::max(scale, box->lengths.maxCoeff());
+    // Rounding: coordinates, their differences and the squared test err by a few ulps of scale.
+    return cutoff + g1 + g2 <= kept_cutoff_ - 1e-12 * scale;
+  }
+
+  // The kept pairs that pass this query's test (and have a marked body, if marked), in the
+  // kept (sorted) order, in chunks (collect_in_chunks) joined in order.
+  void filter_kept(const Mat3X& x, const VecX& r, double cutoff, const std::optional<PeriodicBox>& box,
+                   const std::span<const char>* marked) {
+    const Mat3X* p = &x;
+    if (box) {
+      wrapped_.resize(3, x.cols());
+      parallel_for(x.cols(), [&](std::ptrdiff_t i) { wrapped_.col(i) = wrap_into_box(x.col(i), *box); });
+      p = &wrapped_;
+    }
+    const Vec3 length = box ? box->lengths : Vec3::Zero();
+    const auto n = static_cast<std::int64_t>(kept_.size());
+    for (std::vector<BodyPair>& found : found_) found.clear();
+    collect_in_chunks(n, [&](std::int64_t first, std::int64_t last, std::vector<BodyPair>& found, std::int64_t& checks) {
+      for (std::int64_t k = first; k < last; ++k) {
+        const BodyPair q = kept_[static_cast<std::size_t>(k)];
+        if (marked && !(*marked)[static_cast<std::size_t>(q.i)] && !(*marked)[static_cast<std::size_t>(q.j)]) continue;
+        ++checks;
+        const bool in = box ? detail::within_reach<true>(p->col(q.i).data(), p->col(q.j).data(), r[q.i], r[q.j],
+                                                         cutoff, length.data())
+                            : detail::within_reach<false>(p->col(q.i).data(), p->col(q.j).data(), r[q.i], r[q.j],
+                                                          cutoff, nullptr);
+        if (in) found.push_back(q);
+      }
+    });
+    std::size_t total = 0;
+    for (const std::vector<BodyPair>& found : found_) total += found.size();
+    pairs_.clear();
+    pairs_.reserve(total);
+    for (const std::vector<BodyPair>& found : found_) pairs_.insert(pairs_.end(), found.begin(), found.end());
   }
 
   static double validate(const Mat3X& x, const VecX& radii, double cutoff,
@@ -391,6 +493,15 @@ class CellList {
     }
   }
 
+  // Kept candidates (keep_candidates): the reference's pairs, positions, radii, cutoff and box.
+  double skin_ = 0.0;
+  std::vector<BodyPair> kept_;
+  Mat3X kept_x_;
+  VecX kept_r_;
+  double kept_cutoff_ = 0.0;
+  std::optional<PeriodicBox> kept_box_;
+  Eigen::Index kept_count_ = -1;  // bodies of the reference; -1: none kept
+  bool reused_ = false;
   // Per chunk of a query, in bucket order; buffers beyond the query's chunks stay empty, and
   // all keep their capacity across queries.
   std::vector<std::vector<BodyPair>> found_;
