@@ -7,7 +7,7 @@
 
 Records are matched by --key (its fields' values; floats rounded to 6 digits); a file given
 several times over (repeated runs) gives each key several wall times, of which the median is
-shown. Files may be gzipped (.gz). The table: per key, each --fields value before and after (from the last run) and the
+shown (--time names another time field, e.g. contact_step_s or phases_s.solve). Files may be gzipped (.gz). The table: per key, each --fields value before and after (from the last run) and the
 median wall_time_s before and after with their ratio. --summary instead prints, per field, in
 how many keys it differs, the largest relative difference of numbers, and the sums before and
 after, and the summed median wall time.
@@ -27,7 +27,16 @@ def key_of(record, fields):
     return tuple(values)
 
 
-def load(paths, key_fields, where):
+def field(record, path):
+    """A field by dotted path (phases_s.solve); NaN where missing."""
+    for part in path.split("."):
+        if not isinstance(record, dict) or part not in record:
+            return float("nan")
+        record = record[part]
+    return record
+
+
+def load(paths, key_fields, where, time_field="wall_time_s"):
     walls, last = {}, {}
     for path in paths:
         with (gzip.open(path, "rt") if path.endswith(".gz") else open(path)) as handle:
@@ -38,7 +47,7 @@ def load(paths, key_fields, where):
                 if any(f not in record for f in key_fields):
                     continue
                 k = key_of(record, key_fields)
-                walls.setdefault(k, []).append(record.get("wall_time_s", float("nan")))
+                walls.setdefault(k, []).append(field(record, time_field))
                 last[k] = record
     return walls, last
 
@@ -55,14 +64,16 @@ def main():
     p.add_argument("--where", default="", help="comma-separated field=value filters")
     p.add_argument("--fields", default="iterations,mobility_applications,min_d_over_d_hat_after,complementarity_residual,status")
     p.add_argument("--summary", action="store_true")
+    p.add_argument("--time", default="wall_time_s",
+                   help="the time to compare, a dotted path (contact_step_s, phases_s.solve); default wall_time_s")
     p.add_argument("--before", nargs="+", required=True)
     p.add_argument("--after", nargs="+", required=True)
     a = p.parse_args()
     key_fields = a.key.split(",")
     where = [tuple(w.split("=", 1)) for w in a.where.split(",") if w]
     fields = a.fields.split(",")
-    wb, rb = load(a.before, key_fields, where)
-    wa, ra = load(a.after, key_fields, where)
+    wb, rb = load(a.before, key_fields, where, a.time)
+    wa, ra = load(a.after, key_fields, where, a.time)
     keys = [k for k in rb if k in ra]
     if len(keys) != len(rb) or len(keys) != len(ra):
         print(f"warning: {len(rb)} keys before, {len(ra)} after, {len(keys)} in both", file=sys.stderr)
@@ -88,10 +99,10 @@ def main():
             print(line)
         tb = sum(statistics.median(wb[k]) for k in keys)
         ta = sum(statistics.median(wa[k]) for k in keys)
-        print(f"wall_time_s (sum of medians): {tb:.4g} -> {ta:.4g}, ratio {tb / ta:.2f}")
+        print(f"{a.time} (sum of medians): {tb:.4g} -> {ta:.4g}, ratio {tb / ta:.2f}")
         return
     head = key_fields + [f"{f} (before, after)" for f in fields] + [
-        f"wall, median of {len(wb[keys[0]])} (before)", f"wall, median of {len(wa[keys[0]])} (after)", "ratio"]
+        f"{a.time}, median of {len(wb[keys[0]])} (before)", f"median of {len(wa[keys[0]])} (after)", "ratio"]
     print("| " + " | ".join(head) + " |")
     print("|" + " --- |" * len(head))
     for k in keys:
