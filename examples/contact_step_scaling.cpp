@@ -11,7 +11,8 @@
 // contact step (detection, solve and the whole-step guarantee), flagged and pushed pairs,
 // mobility applications, solver iterations, status, min d / d_hat after, sphere-steps per
 // second of the contact step, its time by phase (ContactStepResult::phase_times: medians over
-// the repeats, phase by phase) and the process's peak resident memory so far (sizes run in the
+// the repeats, phase by phase), its broad-phase queries (and how many kept candidates
+// answered) and the process's peak resident memory so far (sizes run in the
 // order given). Formed mode runs only up to --formed-max bodies: it forms one column of M D per
 // working-set pair, O(N) each. blocks (the library's automatic choice for free draining) forms
 // M D sparsely from the bodies' blocks: no application. --max-memory-mb > 0: ERROR when the
@@ -185,15 +186,17 @@ int run(const Options& o) {
                 sc::json_number(memory) + ", \"phases_s\": {\"setup\": " + sc::json_number(setup_s) +
                 ", \"solve\": " + sc::json_number(solve_s) + ", \"end_check\": " + sc::json_number(end_s) +
                 ", \"interior_check\": " + sc::json_number(interior_s) + ", \"add_pairs\": " +
-                sc::json_number(add_s) + ", \"finish\": " + sc::json_number(finish_s) + "}}");
+                sc::json_number(add_s) + ", \"finish\": " + sc::json_number(finish_s) +
+                "}, \"broad_phase_queries\": " + std::to_string(r.broad_phase_queries) +
+                ", \"broad_phase_reused\": " + std::to_string(r.broad_phase_reused) + "}");
       std::printf("%9zu %11s | %9.4fs | %9.4fs %9.4fs %6.0f | %7zu %7zu | %5zu %4d | %9.6f | %10.3g | %8.0f | %s\n", n,
                   cost_name.c_str(), unconstrained_s, contact_s, contact_times.front(), contact_s / unconstrained_s,
                   r.flagged_pairs, pushed,
                   r.mobility_applications, r.iterations, r.min_distance_ratio, rate, memory,
                   std::string(sc::to_string(r.status)).c_str());
       std::printf("%21s   phases (medians): setup %.4fs, solve %.4fs, end check %.4fs, interior check %.4fs, "
-                  "added pairs %.4fs, result %.4fs\n",
-                  "", setup_s, solve_s, end_s, interior_s, add_s, finish_s);
+                  "added pairs %.4fs, result %.4fs; broad-phase queries %d (%d from kept candidates)\n",
+                  "", setup_s, solve_s, end_s, interior_s, add_s, finish_s, r.broad_phase_queries, r.broad_phase_reused);
       std::fflush(stdout);
       if (r.status != sc::ContactStepStatus::converged) {
         std::printf("ERROR: N = %zu, %s: %s\n", n, cost_name.c_str(), r.message.c_str());

@@ -100,6 +100,17 @@ TEST(SceneFile, CorrectionTurnBoundIsRead) {
   expect_error(j, "contact.max_correction_turn", "must be > 0");
 }
 
+TEST(SceneFile, BroadPhaseSkinIsRead) {
+  json j = two_spheres();
+  EXPECT_LT(apps::read_scene(j).contact.step.broad_phase_skin, 0.0);  // automatic
+  j["contact"]["broad_phase_skin"] = 0.0;
+  EXPECT_EQ(apps::read_scene(j).contact.step.broad_phase_skin, 0.0);
+  j["contact"]["broad_phase_skin"] = 0.5;
+  EXPECT_EQ(apps::read_scene(j).contact.step.broad_phase_skin, 0.5);
+  j["contact"]["broad_phase_skin"] = -0.5;
+  expect_error(j, "contact.broad_phase_skin", "must be >= 0");
+}
+
 TEST(SceneFile, BadInputNamesTheKeyPath) {
   json j = two_spheres();
   j["shape"]["radius"] = -1;

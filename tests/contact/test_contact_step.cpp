@@ -767,6 +767,43 @@ TEST(ContactStep, EndCheckAtTheFirstCorrectionSavesTheGuaranteeRound) {
   }, "lambda");
 }
 
+// ContactStepOptions::broad_phase_skin sets what the step's broad-phase queries cost, never
+// their answer: 2000 spheres of the scaling scene solved with the automatic skin, without
+// kept candidates (0), with a skin too thin for queries after a move (1e-9) and with one wide
+// enough for all (5), give the same forces, pairs and configuration bit for bit. The
+// automatic skin answers the queries after detection from the kept candidates; 0 answers none.
+TEST(ContactStep, BroadPhaseSkinSetsTheCostNotTheAnswer) {
+  SphereSuspension suspension(2000, 5);
+  const sc::ContactStepProblem<sc::Sphere> problem = suspension.problem();
+  const sc::ContactStepResult automatic = sc::solve_contact_step_defect_correction(problem, suspension.mobility);
+  ASSERT_EQ(automatic.status, sc::ContactStepStatus::converged) << automatic.message;
+  ASSERT_GT(automatic.lambda_max, 0.0);
+  EXPECT_GE(automatic.broad_phase_queries, 3);  // detection, the early end check, the end, the interior
+  EXPECT_EQ(automatic.broad_phase_reused, automatic.broad_phase_queries - 1);
+  for (const double skin : {0.0, 1e-9, 5.0}) {
+    SCOPED_TRACE("skin " + std::to_string(skin) + " (1e-9 prints as 0.000000: see the last check)");
+    sc::ContactStepOptions options;
+    options.broad_phase_skin = skin;
+    const sc::ContactStepResult r = sc::solve_contact_step_defect_correction(problem, suspension.mobility, options);
+    EXPECT_EQ(r.status, automatic.status);
+    EXPECT_EQ(r.lambda, automatic.lambda);
+    EXPECT_EQ(r.min_distance_ratio, automatic.min_distance_ratio);
+    EXPECT_EQ(r.broad_phase_queries, automatic.broad_phase_queries);
+    ASSERT_EQ(r.pairs.size(), automatic.pairs.size());
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+      EXPECT_EQ(r.pairs[k].i, automatic.pairs[k].i);
+      EXPECT_EQ(r.pairs[k].j, automatic.pairs[k].j);
+    }
+    for (std::size_t k = 0; k < r.poses.size(); ++k) EXPECT_EQ(r.poses[k].x, automatic.poses[k].x) << "body " << k;
+    if (skin == 5.0) EXPECT_EQ(r.broad_phase_reused, r.broad_phase_queries - 1);
+    else if (skin == 0.0) EXPECT_EQ(r.broad_phase_reused, 0);
+    else EXPECT_LT(r.broad_phase_reused, automatic.broad_phase_reused);  // only queries where nothing moved
+  }
+  sc::ContactStepOptions bad;
+  bad.broad_phase_skin = std::numeric_limits<double>::quiet_NaN();
+  expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(problem, suspension.mobility, bad); }, "broad_phase_skin");
+}
+
 // The cost mode follows the model: blocks for a block-diagonal one (free draining); for any
 // other, formed up to automatic_formed_max_pairs flagged pairs and matrix_free beyond. blocks
 // asked of a model without blocks is refused, naming the option.

@@ -166,6 +166,10 @@ struct ContactStepOptions {
   // that needs more reports failed_separation (the stepper then sub-steps). Bodies without
   // rotational degrees of freedom (spheres) never turn.
   double max_correction_turn = 0.5;
+  // The skin of the candidates the step's broad-phase queries share (CellList::keep_candidates):
+  // negative, automatic (ContactStep::candidate_skin); 0, every query collects afresh. It sets
+  // the cost of the queries, never their answer.
+  double broad_phase_skin = -1.0;
 
   void validate() const {
     if (!(separation_margin >= 0.0 && separation_margin < 1.0))
@@ -181,6 +185,7 @@ struct ContactStepOptions {
     if (!(overlap_ends_min_overlap > 0.0 && std::isfinite(overlap_ends_min_overlap)))
       fail_argument("ContactStepOptions.overlap_ends_min_overlap",
                     "must be positive and finite, got " + std::to_string(overlap_ends_min_overlap));
+    require_finite(broad_phase_skin, "ContactStepOptions.broad_phase_skin");
     if (!(max_correction_turn > 0.0))
       fail_argument("ContactStepOptions.max_correction_turn",
                     "must be > 0 radians, got " + std::to_string(max_correction_turn));
@@ -244,6 +249,10 @@ struct ContactStepResult {
   MobilityCost cost = MobilityCost::formed;  // the cost mode used (automatic resolved)
   double wall_time_s = 0.0;
   ContactStepPhaseTimes phase_times;    // wall_time_s by phase
+  // Broad-phase queries of the step over all bodies (detection, end and whole-step checks),
+  // and how many the candidates kept within ContactStepOptions::broad_phase_skin answered.
+  int broad_phase_queries = 0;
+  int broad_phase_reused = 0;
   double d_try = 0.0;                   // the threshold used
   double min_distance_ratio = 0.0;      // min d^P over all pairs of Q(lambda) / d_hat (inf: < 2 bodies)
   double barrier_energy = 0.0;          // sum b(d_k) over flagged pairs at Q(lambda), eq. 10 with eps_reg = d_try
@@ -361,7 +370,7 @@ class ContactStep {
       for (const S& shape : problem.shapes)
         nodes_.push_back(surface_nodes(shape, options.node_spacing > 0.0 ? options.node_spacing : contact_node_spacing(shape, problem.d_hat)));
     }
-    cells_.keep_candidates(candidate_skin(problem));
+    cells_.keep_candidates(options.broad_phase_skin < 0.0 ? candidate_skin(problem) : options.broad_phase_skin);
     trial_ = advance_all(problem.poses, problem.U, dofs_, problem.dt);  // Q*, eq. 16
     scratch_poses_ = trial_;
     const std::span<const Pose> trial(trial_);
@@ -1161,6 +1170,8 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
     r.status = outcome.converged ? ContactStepStatus::converged : ContactStepStatus::not_converged;
     r.message = outcome.message;
   }
+  r.broad_phase_queries = static_cast<int>(step.cells().queries());
+  r.broad_phase_reused = static_cast<int>(step.cells().reused_queries());
   r.pairs = std::move(step).release_pairs();  // the step is finished: e is not used below
   r.columns = std::move(step).release_columns();
   r.poses = std::move(step).release_last_poses();

@@ -93,8 +93,11 @@ class CellList {
     kept_.clear();
     kept_count_ = -1;
   }
-  // Whether the last query answered from kept candidates.
+  // Whether the last query answered from kept candidates; queries of this object so far (of
+  // two bodies or more), and how many of them the kept candidates answered.
   bool last_query_reused() const { return reused_; }
+  std::int64_t queries() const { return queries_; }
+  std::int64_t reused_queries() const { return reused_queries_; }
 
   // All candidate pairs (i < j), lexicographically sorted; valid until the next call.
   const std::vector<BodyPair>& find_pairs(const Mat3X& positions, const VecX& radii, double cutoff,
@@ -139,9 +142,11 @@ class CellList {
       n_ = {0, 0, 0};
       return pairs_;
     }
+    ++queries_;
     if (covered_by_kept(positions, radii, cutoff, box)) {
       filter_kept(positions, radii, cutoff, box, marked);
       reused_ = true;
+      ++reused_queries_;
       return pairs_;
     }
     n_ = {0, 0, 0};
@@ -502,6 +507,7 @@ class CellList {
   std::optional<PeriodicBox> kept_box_;
   Eigen::Index kept_count_ = -1;  // bodies of the reference; -1: none kept
   bool reused_ = false;
+  std::int64_t queries_ = 0, reused_queries_ = 0;
   // Per chunk of a query, in bucket order; buffers beyond the query's chunks stay empty, and
   // all keep their capacity across queries.
   std::vector<std::vector<BodyPair>> found_;

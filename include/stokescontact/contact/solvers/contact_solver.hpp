@@ -178,7 +178,7 @@ inline std::string trimmed(std::string message) {
 //  - any failure by the LCP sequence (lcp-newton: exact products, no probing, no ray search),
 //    whose LCPs hold contact networks where the corrections stall.
 // Each solve starts afresh (its probes cost again). The result counts the applications,
-// iterations and wall time (and its phases) of every solve; its `fallback` names the solver
+// iterations, wall time (and its phases) and broad-phase queries of every solve; its `fallback` names the solver
 // whose answer it is (empty: every fallback failed too, and the default solver's failure is
 // returned, with theirs in its message).
 template <Shape S, MobilityOperator M>
@@ -189,12 +189,15 @@ ContactStepResult solve_failed_step_again(const ContactStepProblem<S>& problem, 
   int iterations = failed.iterations;
   double wall_time_s = failed.wall_time_s;
   ContactStepPhaseTimes phase_times = failed.phase_times;
+  int queries = failed.broad_phase_queries, reused = failed.broad_phase_reused;
   std::string tried;
   const auto attempt = [&](std::string_view name, ContactStepResult again) -> std::optional<ContactStepResult> {
     applications += again.mobility_applications;
     iterations += again.iterations;
     wall_time_s += again.wall_time_s;
     phase_times += again.phase_times;
+    queries += again.broad_phase_queries;
+    reused += again.broad_phase_reused;
     if (again.status == ContactStepStatus::failed_separation) {
       tried += "; " + std::string(name) + ", tried on this step: " + trimmed(again.message);
       return std::nullopt;
@@ -203,6 +206,8 @@ ContactStepResult solve_failed_step_again(const ContactStepProblem<S>& problem, 
     again.iterations = iterations;
     again.wall_time_s = wall_time_s;
     again.phase_times = phase_times;
+    again.broad_phase_queries = queries;
+    again.broad_phase_reused = reused;
     again.fallback = name;
     again.message = "solved again by " + std::string(name) + " after the default solver's " + trimmed(failed.message) +
                     (again.message.empty() ? std::string() : "; " + std::string(name) + ": " + again.message);
