@@ -799,6 +799,22 @@ TEST(ContactStep, BroadPhaseSkinSetsTheCostNotTheAnswer) {
     else if (skin == 0.0) EXPECT_EQ(r.broad_phase_reused, 0);
     else EXPECT_LT(r.broad_phase_reused, automatic.broad_phase_reused);  // only queries where nothing moved
   }
+  // One body flung across the scene (100 times its speed: 5 radii in the step) neither widens
+  // the automatic skin to its motion (one wide skin would make every pair of the scene a
+  // candidate) nor changes the answer: the same forces and poses as without kept candidates.
+  sc::VecX fast_U = suspension.U;
+  fast_U.segment<3>(0) *= 100.0;
+  const sc::ContactStepProblem<sc::Sphere> flung{problem.shapes, problem.poses, fast_U, problem.dt, problem.d_hat};
+  sc::ContactStepOptions off;
+  off.broad_phase_skin = 0.0;
+  const sc::ContactStepResult fast = sc::solve_contact_step_defect_correction(flung, suspension.mobility);
+  const sc::ContactStepResult fast_off = sc::solve_contact_step_defect_correction(flung, suspension.mobility, off);
+  EXPECT_EQ(fast.status, fast_off.status) << fast.message;
+  EXPECT_EQ(fast.lambda, fast_off.lambda);
+  for (std::size_t k = 0; k < fast.poses.size(); ++k) EXPECT_EQ(fast.poses[k].x, fast_off.poses[k].x) << "body " << k;
+  sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility> step(flung, suspension.mobility, {});
+  EXPECT_LT(step.candidate_skin(flung), 0.2);  // 2 d_hat + dt rms |u - u_mean|, not dt max |u - u_mean| = 5.3
+
   sc::ContactStepOptions bad;
   bad.broad_phase_skin = std::numeric_limits<double>::quiet_NaN();
   expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(problem, suspension.mobility, bad); }, "broad_phase_skin");

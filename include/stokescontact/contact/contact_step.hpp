@@ -425,17 +425,23 @@ class ContactStep {
 
   // The skin of the candidates the step's broad-phase queries share (detection, the early and
   // final end checks, the whole-step check: CellList::keep_candidates): 2 d_hat plus the
-  // farthest trial motion relative to the mean, dt max_k |u_k - u_mean|, room for corrections
-  // that move two bodies back by half their trial motion each. A query whose bodies moved
-  // farther collects afresh (and keeps its own candidates): the skin sets the cost, never the
-  // answer. (At 1e5 spheres, |f| = 100, dt = d_hat = 0.01, the later queries needed 0.02-0.04
-  // of the skin's 0.073; twice the trial motion, 0.116, made detection's query 10% slower.)
+  // trial motion relative to the mean, dt times the root mean square of |u_k - u_mean|, room
+  // for corrections that move two bodies back by half their trial motion each; at most the
+  // largest bounding radius. Not the fastest body's motion: one body flung across the scene
+  // would widen every cell and make every pair a candidate. A query whose bodies moved farther
+  // collects afresh (and keeps its own candidates): the skin sets the cost, never the answer.
+  // (At 1e5 spheres, |f| = 100, dt = d_hat = 0.01, the later queries needed 0.02-0.04 of the
+  // skin's 0.073; twice the trial motion, 0.116, made detection's query 10% slower.)
   double candidate_skin(const ContactStepProblem<S>& problem) const {
-    const Vec3 mean = detail::mean_velocity(problem.U, problem.poses.size(), dofs_);
-    double fastest = 0.0;
-    for (std::size_t k = 0; k < problem.poses.size(); ++k)
-      fastest = std::max(fastest, (rigid_velocity(problem.U, k, dofs_).u - mean).norm());
-    return 2.0 * problem.d_hat + problem.dt * fastest;
+    const std::size_t n = problem.poses.size();
+    const Vec3 mean = detail::mean_velocity(problem.U, n, dofs_);
+    double squares = 0.0, largest_radius = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      squares += (rigid_velocity(problem.U, k, dofs_).u - mean).squaredNorm();
+      largest_radius = std::max(largest_radius, bounding_radius(shape_of(problem.shapes, k)));
+    }
+    const double rms = n == 0 ? 0.0 : std::sqrt(squares / static_cast<double>(n));
+    return std::min(2.0 * problem.d_hat + problem.dt * rms, largest_radius);
   }
 
   // Adds pairs (i < j) not yet flagged, measured at Q*; returns how many were new. A pair
