@@ -150,8 +150,9 @@ RelativePairs find_pairs_relative(std::span<const S> shapes, std::span<const Pos
   CellList local;
   CellList& list = cells != nullptr ? *cells : local;
   // Each candidate's threshold (NaN where its bounding balls at Q* are beyond it), then the
-  // pairs within reach measured in place in the result (one buffer written once: at 1e5
-  // spheres a chunked buffer of measurements, moved into the result, cost a third more).
+  // pairs within reach measured in place in the result, a chunk at a time, and those within
+  // their threshold kept (at 1e5 spheres a buffer of measurements moved into the result cost
+  // a third more; chunks bound the memory where bounding balls are loose, as for rods).
   const std::vector<BodyPair>& candidates =
       detail::swept_candidates(b.centres, b.radii, b.body_radius, multiplier * d_hat, box, list);
   std::vector<double> threshold(candidates.size());
@@ -164,29 +165,28 @@ RelativePairs find_pairs_relative(std::span<const S> shapes, std::span<const Pos
     const bool near = is_candidate_pair(trial[i].x, trial[j].x, bounding_radius(si), bounding_radius(sj), d_try, box);
     threshold[static_cast<std::size_t>(k)] = near ? d_try : std::numeric_limits<double>::quiet_NaN();
   });
-  RelativePairs out;
-  std::vector<BodyPair> near;
+  std::vector<std::size_t> near;
   for (std::size_t k = 0; k < candidates.size(); ++k)
-    if (!std::isnan(threshold[k])) {
-      near.push_back(candidates[k]);
-      out.d_try.push_back(threshold[k]);
+    if (!std::isnan(threshold[k])) near.push_back(k);
+  RelativePairs out;
+  constexpr std::size_t kChunk = 16384;
+  for (std::size_t first = 0; first < near.size(); first += kChunk) {
+    const std::size_t count = std::min(kChunk, near.size() - first), kept = out.pairs.size();
+    out.pairs.resize(kept + count);
+    parallel_for(static_cast<std::ptrdiff_t>(count), [&](std::ptrdiff_t k) {
+      const BodyPair& c = candidates[near[first + static_cast<std::size_t>(k)]];
+      out.pairs[kept + static_cast<std::size_t>(k)] = detail::contact_pair(shapes, trial, c.i, c.j, box);
+    });
+    std::size_t end = kept;  // those within their threshold, in order
+    for (std::size_t k = 0; k < count; ++k) {
+      const double d_try = threshold[near[first + k]];
+      if (!(out.pairs[kept + k].points.distance <= d_try)) continue;
+      if (end != kept + k) out.pairs[end] = std::move(out.pairs[kept + k]);
+      out.d_try.push_back(d_try);
+      ++end;
     }
-  out.pairs.resize(near.size());
-  parallel_for(static_cast<std::ptrdiff_t>(near.size()), [&](std::ptrdiff_t k) {
-    const BodyPair& c = near[static_cast<std::size_t>(k)];
-    out.pairs[static_cast<std::size_t>(k)] = detail::contact_pair(shapes, trial, c.i, c.j, box);
-  });
-  std::size_t kept = 0;  // those within their threshold, in order
-  for (std::size_t k = 0; k < near.size(); ++k)
-    if (out.pairs[k].points.distance <= out.d_try[k]) {
-      if (kept != k) {
-        out.pairs[kept] = std::move(out.pairs[k]);
-        out.d_try[kept] = out.d_try[k];
-      }
-      ++kept;
-    }
-  out.pairs.resize(kept);
-  out.d_try.resize(kept);
+    out.pairs.resize(end);
+  }
   return out;
 }
 
