@@ -430,8 +430,9 @@ class ContactStep {
   // largest bounding radius. Not the fastest body's motion: one body flung across the scene
   // would widen every cell and make every pair a candidate. A query whose bodies moved farther
   // collects afresh (and keeps its own candidates): the skin sets the cost, never the answer.
-  // (At 1e5 spheres, |f| = 100, dt = d_hat = 0.01, the later queries needed 0.02-0.04 of the
-  // skin's 0.073; twice the trial motion, 0.116, made detection's query 10% slower.)
+  // (At 1e5 spheres, |f| = 100, dt = d_hat = 0.01, the later queries needed 0.032-0.033 of the
+  // skin's 0.073; a skin of 0.116 gave detection's query 1.2x the profile's samples:
+  // docs/results.md, "The step's queries share one broad phase".)
   double candidate_skin(const ContactStepProblem<S>& problem) const {
     const std::size_t n = problem.poses.size();
     const Vec3 mean = detail::mean_velocity(problem.U, n, dofs_);
