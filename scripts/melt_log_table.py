@@ -13,9 +13,10 @@ log's last line when it is not a step: the stepper's message, or the timeout's e
 
     /usr/bin/python3 scripts/melt_log_table.py --cost LOG [LOG ...]
 
-With --totals, the sums that compare two builds on the same runs: solver iterations in all, the
-wall time in all and per iteration, the steps not converged (committed within the separation
-margin) and sub-stepped, and the smallest min d / d_hat.
+With --totals, the sums that compare two builds on the same runs: solver iterations in all and
+in the first step (the one step two builds solve from the same state, when a run starts from a
+checkpoint), the wall time in all and per iteration, the steps not converged (committed within
+the separation margin) and sub-stepped, and the smallest min d / d_hat.
 
     /usr/bin/python3 scripts/melt_log_table.py --totals LOG [LOG ...]
 """
@@ -76,17 +77,17 @@ def cost_row(path):
 def totals_row(path):
     steps = steps_of(path)
     if not steps:
-        return f"| {path} | 0 | | | | | | |"
+        return f"| {path} | 0 | | | | | | | |"
     iterations = sum(s["iterations"] for s in steps)
     wall = sum(s["wall_time_s"] for s in steps)
     not_converged = sum(1 for s in steps if s["status"] != "converged")
     substepped = sum(1 for s in steps if s["substeps"] > 1)
-    return (f"| {path} | {len(steps)} | {iterations} | {wall:.1f} | {1000 * wall / max(iterations, 1):.2f} | "
+    return (f"| {path} | {len(steps)} | {iterations} | {steps[0]['iterations']} | {wall:.1f} | {1000 * wall / max(iterations, 1):.2f} | "
             f"{not_converged} | {substepped} | {min(s['min_distance_ratio'] for s in steps):.4f} |")
 
 
 TABLES = {  # option: (header, row of one log)
-    "--totals": (["log", "steps", "iterations", "wall (s)", "wall per iteration (ms)", "not converged",
+    "--totals": (["log", "steps", "iterations", "first step's iterations", "wall (s)", "wall per iteration (ms)", "not converged",
                   "sub-stepped", "min d / d_hat"], totals_row),
     "--cost": (["log", "steps", "flagged pairs", "pushed pairs", "iterations", "sub-stepped", "solved again",
                 "median step (s)", "all steps (s)", "min d / d_hat", "largest turn (rad)", "end"], cost_row),
