@@ -5,7 +5,7 @@
 // rod propelled at speed U0 along its axis n (a force U0 zeta_par n, so that M F = U0 n), the
 // default contact solver holding every gap at >= d_hat each step.
 //
-//   brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]
+//   brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--box-aspect 1] [--u0 0,1,2,4] [--dt 1e-3]
 //                 [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]
 //                 [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]
 //                 [--overlap-ends-angle 0.1] [--start random|aligned|compressed] [--melt 0]
@@ -17,6 +17,9 @@
 // --u0 is given as U0 / (L D_R), the paper's Fig. 6 axis (D_R = kT / zeta_r, eq. 49); --dt,
 // --equilibrate, --average, --melt and --melt-dt are in rotational times 1 / D_R. --eta gives
 // the packing fraction of the hard core D + d_hat instead of phi (that of diameter D).
+// The box: a cube, or with --box-aspect A > 1 a box A times as long along z as across (Lx = Ly,
+// Lz = A Lx; Yan et al.'s aligned runs used 72 D x 15 D x 15 D for 2000 rods, A = 4.8), with
+// --start aligned (the rods along the long side) or --load-state of such a box.
 // Start: --start random, periodic_random_placement of the seed (every gap > d_hat; phi < 0.3);
 // --start aligned, periodic_aligned_columns (every rod along z, Yan et al. Sec. IV.B's aligned
 // start, for dense suspensions); --start compressed, an isotropic dense start: random placement
@@ -102,7 +105,7 @@ namespace ex = examples;
 namespace brownian_rods {
 
 constexpr const char* kUsage =
-    "usage: brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--u0 0,1,2,4] [--dt 1e-3]\n"
+    "usage: brownian_rods [--aspect 5] [--phi 0.02 | --eta ETA] [--n 1000] [--box-aspect 1] [--u0 0,1,2,4] [--dt 1e-3]\n"
     "                     [--d-hat 1e-2] [--equilibrate 0.5] [--average 2] [--solver default] [--seed 1]\n"
     "                     [--directions particle|surface|overlap-ends] [--overlap-ends-min-overlap 0.1]\n"
     "                     [--overlap-ends-angle 0.1]\n"
@@ -114,6 +117,7 @@ constexpr const char* kUsage =
 
 struct Options {
   double aspect = 5.0;
+  double box_aspect = 1.0;  // Lz / Lx of the box, Lx = Ly
   double phi = 0.02;
   std::optional<double> eta;  // of the hard core D + d_hat; sets phi when given
   std::size_t n = 1000;
@@ -171,6 +175,10 @@ Options parse(int argc, char** argv) {
   if (o.start != "random" && o.start != "aligned" && o.start != "compressed")
     throw std::invalid_argument("--start must be random, aligned or compressed, got '" + o.start + "'");
   if (!o.load_state.empty()) o.start = "checkpoint";
+  o.box_aspect = args.number("--box-aspect", o.box_aspect, 0.0);
+  if (!(o.box_aspect >= 1.0)) throw std::invalid_argument("--box-aspect must be >= 1");
+  if (o.box_aspect != 1.0 && (o.start == "random" || o.start == "compressed"))
+    throw std::invalid_argument("--box-aspect other than 1 needs --start aligned or --load-state (random and compressed starts fill a cube)");
   o.compress_from = args.number("--compress-from", o.compress_from, 0.0);
   o.compress_rate = args.number("--compress-rate", o.compress_rate, 0.0);
   o.compress_steps = static_cast<long>(args.integer("--compress-steps", o.compress_steps, 0));
@@ -224,7 +232,8 @@ std::optional<double> mcgrother_z(double aspect, double eta) {
 struct System {
   sc::Spherocylinder rod;
   sc::Mat6 body_mobility;
-  double D_R = 0.0, m_par = 0.0, side = 0.0;
+  double D_R = 0.0, m_par = 0.0;
+  sc::Vec3 lengths = sc::Vec3::Zero();  // the periodic box
 };
 
 using RodStepper = sc::TimeStepper<sc::Spherocylinder, sc::FreeDrainingMobility>;
@@ -237,7 +246,7 @@ std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, cons
   sc::TimeStepperOptions options;
   options.dt = dt_D_R / s.D_R;
   options.d_hat = o.d_hat;
-  options.box = sc::PeriodicBox{sc::Vec3::Constant(s.side)};
+  options.box = sc::PeriodicBox{s.lengths};
   options.contact_step.directions = ex::contact_directions(o.directions);
   options.contact_step.overlap_ends_min_overlap = o.min_overlap;
   options.contact_step.overlap_ends_angle = o.ends_angle;
@@ -259,17 +268,18 @@ std::unique_ptr<RodStepper> make_stepper(const Options& o, const System& s, cons
   return stepper;
 }
 
-// --start compressed (see the top): `poses` in the cube of side s.side, compressed to side
-// `to_side` in place, its steps drawing from `noise` on. Prints what it took.
-void compress(const Options& o, System s, std::vector<sc::Pose>& poses, double to_side, sc::GaussianStream& noise) {
+// --start compressed (see the top): `poses` in the box s.lengths, compressed to the box
+// `to_lengths` of the same shape in place, its steps drawing from `noise` on. Prints what it took.
+void compress(const Options& o, System s, std::vector<sc::Pose>& poses, const sc::Vec3& to_lengths,
+              sc::GaussianStream& noise) {
   const auto t0 = std::chrono::steady_clock::now();
   double rate = o.compress_rate;
   long rescalings = 0, halvings = 0;
-  while (s.side > to_side) {
-    const double factor = std::max(to_side / s.side, 1.0 - rate);
+  while (s.lengths.x() > to_lengths.x()) {
+    const double factor = std::max(to_lengths.x() / s.lengths.x(), 1.0 - rate);
     std::vector<sc::Pose> scaled = poses;
     sc::rescale_centres(scaled, factor);
-    const sc::PeriodicBox box{sc::Vec3::Constant(s.side * factor)};
+    const sc::PeriodicBox box{s.lengths * factor};
     if (sc::minimum_pair_distance(s.rod, std::span<const sc::Pose>(scaled), box).distance < 0.5 * o.d_hat) {
       rate *= 0.5;
       ++halvings;
@@ -277,7 +287,7 @@ void compress(const Options& o, System s, std::vector<sc::Pose>& poses, double t
       continue;
     }
     poses = std::move(scaled);
-    s.side *= factor;
+    s.lengths *= factor;
     ++rescalings;
     sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);
     const std::unique_ptr<RodStepper> stepper = make_stepper(o, s, poses, o.melt_dt, 0.0, mobility, noise);
@@ -293,7 +303,7 @@ void compress(const Options& o, System s, std::vector<sc::Pose>& poses, double t
 int run(const Options& o) {
   constexpr double kT = 1.0, viscosity = 1.0, D = 1.0;
   const double L = o.aspect * D;
-  System s{sc::Spherocylinder{L, 0.5 * D}, {}, 0.0, 0.0, 0.0};
+  System s{sc::Spherocylinder{L, 0.5 * D}, {}, 0.0, 0.0, sc::Vec3::Zero()};
   s.body_mobility = sc::spherocylinder_mobility(s.rod, viscosity);
   s.D_R = kT * s.body_mobility(3, 3);  // 1 / zeta_r (eq. 49)
   s.m_par = s.body_mobility(2, 2);     // 1 / zeta_par (eq. 47), axis = body z
@@ -304,8 +314,9 @@ int run(const Options& o) {
     throw std::invalid_argument(std::string(o.eta ? "--eta gives phi = " : "--phi = ") + std::to_string(phi) +
                                 (o.start == "random" ? ": phi must lie in (0, 0.3) with --start random (denser: --start aligned)"
                                                      : ": phi must lie in (0, 0.74)"));
-  s.side = std::cbrt(static_cast<double>(o.n) * rod_volume(D) / phi);
-  const double number_density = static_cast<double>(o.n) / (s.side * s.side * s.side);
+  const double side = std::cbrt(static_cast<double>(o.n) * rod_volume(D) / phi / o.box_aspect);
+  s.lengths = sc::Vec3(side, side, o.box_aspect * side);
+  const double number_density = static_cast<double>(o.n) / (s.lengths.x() * s.lengths.y() * s.lengths.z());
   const double eta = number_density * rod_volume(Dh);
   const double b2 = std::numbers::pi * (2.0 * Dh * Dh * Dh / 3.0 + L * Dh * Dh + 0.25 * L * L * Dh);
   const double b2n = b2 * number_density;
@@ -320,44 +331,46 @@ int run(const Options& o) {
     if (c.poses.size() != o.n)
       throw std::invalid_argument("--load-state " + o.load_state + " holds " + std::to_string(c.poses.size()) +
                                   " rods, --n is " + std::to_string(o.n));
-    if (!c.box || (c.box->lengths.array() - c.box->lengths.x()).abs().maxCoeff() > 1e-12 * c.box->lengths.x())
-      throw std::invalid_argument("--load-state " + o.load_state + ": its box is not a cube");
+    if (!c.box || std::abs(c.box->lengths.y() - c.box->lengths.x()) > 1e-12 * c.box->lengths.x() ||
+        std::abs(c.box->lengths.z() - o.box_aspect * c.box->lengths.x()) > 1e-12 * c.box->lengths.z())
+      throw std::invalid_argument("--load-state " + o.load_state + ": its box is not Lx = Ly, Lz = --box-aspect Lx = " +
+                                  std::to_string(o.box_aspect) + " Lx");
     if (!c.noise) throw std::invalid_argument("--load-state " + o.load_state + " holds no Brownian stream");
     start = c.poses;
     noise = *c.noise;
     start_time = c.time;
-    const double saved_side = c.box->lengths.x();
-    if (saved_side < s.side * (1.0 - 1e-12)) {  // a denser state: expanded at once, no gap shortens
-      sc::rescale_centres(start, s.side / saved_side);
+    const double saved_side = c.box->lengths.x(), side_now = s.lengths.x();
+    if (saved_side < side_now * (1.0 - 1e-12)) {  // a denser state: expanded at once, no gap shortens
+      sc::rescale_centres(start, side_now / saved_side);
       std::printf("expansion: side %.6g -> %.6g (eta %.4f -> %.4f) in one rescaling, every gap kept or widened\n",
-                  saved_side, s.side, eta * std::pow(s.side / saved_side, 3), eta);
-    } else if (saved_side > s.side * (1.0 + 1e-12)) {  // a more dilute state: compressed as --start compressed
+                  saved_side, side_now, eta * std::pow(side_now / saved_side, 3), eta);
+    } else if (saved_side > side_now * (1.0 + 1e-12)) {  // a more dilute state: compressed as --start compressed
       System from = s;
-      from.side = saved_side;
-      std::printf("compression from eta %.4f:\n", eta * std::pow(s.side / saved_side, 3));
-      compress(o, from, start, s.side, noise);
+      from.lengths = c.box->lengths;
+      std::printf("compression from eta %.4f:\n", eta * std::pow(side_now / saved_side, 3));
+      compress(o, from, start, s.lengths, noise);
     }
   } else if (o.start == "aligned") {
-    start = sc::periodic_aligned_columns(s.rod, o.n, s.side, o.d_hat, o.seed);
+    start = sc::periodic_aligned_columns(s.rod, o.n, sc::PeriodicBox{s.lengths}, o.d_hat, o.seed);
   } else if (o.start == "random") {
-    start = sc::periodic_random_placement(s.rod, o.n, s.side, o.d_hat, o.seed);
+    start = sc::periodic_random_placement(s.rod, o.n, s.lengths.x(), o.d_hat, o.seed);
   } else {  // compressed: placed at the hard-core packing compress_from, then compressed
     const double phi_from = o.compress_from * rod_volume(D) / rod_volume(Dh);
     if (!(phi_from < 0.3)) throw std::invalid_argument("--compress-from gives phi = " + std::to_string(phi_from) + ", must be < 0.3");
     System from = s;
-    from.side = std::cbrt(static_cast<double>(o.n) * rod_volume(D) / phi_from);
-    start = sc::periodic_random_placement(s.rod, o.n, from.side, o.d_hat, o.seed);
-    compress(o, from, start, s.side, noise);
+    from.lengths = sc::Vec3::Constant(std::cbrt(static_cast<double>(o.n) * rod_volume(D) / phi_from));
+    start = sc::periodic_random_placement(s.rod, o.n, from.lengths.x(), o.d_hat, o.seed);
+    compress(o, from, start, s.lengths, noise);
   }
-  std::printf("Brownian rods: N = %zu spherocylinders L/D = %g in a periodic cube of side %.4g, phi %g (hard core %.4g), "
+  std::printf("Brownian rods: N = %zu spherocylinders L/D = %g in a periodic box %.4g x %.4g x %.4g, phi %g (hard core %.4g), "
               "B2 n = %.5f,\nfree draining (Yan eq. 45-50), D_R = %.5g, equilibrate %g, average %g (1 / D_R), d_hat %g, "
               "solver %s, %s directions, start %s\n",
-              o.n, o.aspect, s.side, phi, eta, b2n, s.D_R, o.equilibrate, o.average, o.d_hat, o.solver.c_str(),
+              o.n, o.aspect, s.lengths.x(), s.lengths.y(), s.lengths.z(), phi, eta, b2n, s.D_R, o.equilibrate, o.average, o.d_hat, o.solver.c_str(),
               ex::directions_name(o.directions), o.start.c_str());
   double start_order = order_parameter(start);
   const auto save_state = [&](const std::vector<sc::Pose>& poses, const sc::GaussianStream& stream, double time) {
     if (!o.save_state.empty())
-      sc::save_checkpoint(o.save_state, sc::Checkpoint{time, sc::PeriodicBox{sc::Vec3::Constant(s.side)}, poses, stream});
+      sc::save_checkpoint(o.save_state, sc::Checkpoint{time, sc::PeriodicBox{s.lengths}, poses, stream});
   };
   if (o.melt > 0.0) {
     sc::FreeDrainingMobility mobility(s.body_mobility, o.n, 6);

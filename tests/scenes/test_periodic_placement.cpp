@@ -22,19 +22,28 @@ namespace sc = stokescontact;
 
 namespace {
 
-// The smallest gap between any two bodies over all 27 neighbouring images: no minimum image used.
+// The smallest gap between any two bodies over all 27 neighbouring images: no minimum image
+// used. Images whose centres are more than 2 bounding radii + 1 apart are not measured (their
+// gap is > 1, more than every gap these tests compare with).
 template <sc::Shape S>
-double smallest_gap_over_images(const S& shape, const std::vector<sc::Pose>& poses, double side) {
+double smallest_gap_over_images(const S& shape, const std::vector<sc::Pose>& poses, const sc::Vec3& lengths) {
   double best = 1e300;
+  const double reach = 2.0 * sc::bounding_radius(shape) + 1.0;
   for (std::size_t i = 0; i < poses.size(); ++i)
     for (std::size_t j = i + 1; j < poses.size(); ++j)
       for (int a = -1; a <= 1; ++a)
         for (int b = -1; b <= 1; ++b)
           for (int c = -1; c <= 1; ++c) {
-            const sc::Pose image{poses[j].x + side * sc::Vec3(a, b, c), poses[j].q};
+            const sc::Pose image{poses[j].x + lengths.cwiseProduct(sc::Vec3(a, b, c)), poses[j].q};
+            if ((image.x - poses[i].x).norm() > reach) continue;
             best = std::min(best, sc::closest_points(shape, poses[i], shape, image).distance);
           }
   return best;
+}
+
+template <sc::Shape S>
+double smallest_gap_over_images(const S& shape, const std::vector<sc::Pose>& poses, double side) {
+  return smallest_gap_over_images(shape, poses, sc::Vec3::Constant(side));
 }
 
 // Each pair's smallest gap over the 27 neighbouring images, pairs in order (i < j).
@@ -112,6 +121,38 @@ TEST(PeriodicPlacement, AlignedColumnsReachADenseContactFreeStart) {
   const std::vector<sc::Pose> again = sc::periodic_aligned_columns(rod, count, side, gap, 3);
   for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(poses[k].x, again[k].x);
   EXPECT_NE(poses[0].x, sc::periodic_aligned_columns(rod, count, side, gap, 4)[0].x);
+}
+
+// Yan et al.'s elongated box (72 D x 15 D x 15 D for 2000 rods), here 1000 rods at packing
+// 0.44 in a box 4.8 times as long as wide (12.6 x 12.6 x 60.1), the rods along its long side (z): inside the box,
+// contact free through every image, and filling the long side (no hole longer than a rod).
+TEST(PeriodicPlacement, AlignedColumnsFillAnElongatedBox) {
+  const sc::Spherocylinder rod{5.0, 0.5};
+  const double gap = 0.01, volume = std::numbers::pi * (0.25 * rod.length + 1.0 / 6.0);
+  const std::size_t count = 1000;
+  const double side = std::cbrt(count * volume / (0.44 * 4.8));
+  const sc::PeriodicBox box{sc::Vec3(side, side, 4.8 * side)};
+  const std::vector<sc::Pose> poses = sc::periodic_aligned_columns(rod, count, box, gap, 5);
+  ASSERT_EQ(poses.size(), count);
+  std::vector<double> z;
+  for (const sc::Pose& p : poses) {
+    EXPECT_TRUE((p.x.array() >= 0.0).all() && (p.x.array() < box.lengths.array()).all()) << p.x.transpose();
+    EXPECT_LT((p.rotation().col(2) - sc::Vec3::UnitZ()).norm(), 1e-15);
+    z.push_back(p.x.z());
+  }
+  EXPECT_GT(smallest_gap_over_images(rod, poses, box.lengths), gap);
+  std::sort(z.begin(), z.end());
+  double largest_hole = z.front() + box.lengths.z() - z.back();
+  for (std::size_t k = 1; k < z.size(); ++k) largest_hole = std::max(largest_hole, z[k] - z[k - 1]);
+  EXPECT_LT(largest_hole, rod.length);
+  // The cube is the box of equal sides: the same start.
+  const std::vector<sc::Pose> cube = sc::periodic_aligned_columns(rod, 100, 14.0, gap, 3);
+  const std::vector<sc::Pose> boxed = sc::periodic_aligned_columns(rod, 100, sc::PeriodicBox{sc::Vec3::Constant(14.0)}, gap, 3);
+  for (std::size_t k = 0; k < cube.size(); ++k) EXPECT_EQ(cube[k].x, boxed[k].x);
+  test_support::expect_rejects([&] { sc::periodic_aligned_columns(rod, 2, sc::PeriodicBox{sc::Vec3(14.0, 15.0, 60.0)}, gap, 1); },
+                               "box.lengths");
+  test_support::expect_rejects([&] { sc::periodic_aligned_columns(rod, 2, sc::PeriodicBox{sc::Vec3(14.0, 14.0, 11.9)}, 0.0, 1); },
+                               "box.lengths");
 }
 
 // rescale_centres: an expansion widens or keeps every pair's gap (brute force over the 27

@@ -84,22 +84,29 @@ std::vector<Pose> periodic_random_placement(const S& shape, std::size_t count, d
   return poses;
 }
 
-// `count` spherocylinders along z in the periodic cube [0, side)^3, every gap > min_gap (see
-// the top). Throws std::invalid_argument naming "side" (too small for the minimum image),
-// "min_gap" (< 0) or "count" (the columns would be closer than
-// 2 radius + min_gap: the packing is too high for aligned columns in this box).
-inline std::vector<Pose> periodic_aligned_columns(const Spherocylinder& rod, std::size_t count, double side,
+// `count` spherocylinders along z in the periodic box [0, Lx) x [0, Ly) x [0, Lz), every gap
+// > min_gap (see the top), columns along z; the cross-section must be square (Lx = Ly), Lz
+// any length (Lz > Lx: Yan et al.'s elongated box with the rods along its long side). Throws
+// std::invalid_argument naming "box.lengths" (a side too small for the minimum image, or Lx !=
+// Ly), "min_gap" (< 0) or "count" (the columns would be closer than 2 radius + min_gap: the
+// packing is too high for aligned columns in this box).
+inline std::vector<Pose> periodic_aligned_columns(const Spherocylinder& rod, std::size_t count, const PeriodicBox& box,
                                                   double min_gap, std::uint64_t seed) {
   validate(rod);
   require_non_negative(min_gap, "min_gap");
+  require_finite(box.lengths, "box.lengths");
   const double reach = 2.0 * bounding_radius(rod) + min_gap;
-  if (!(side >= 2.0 * reach))
-    fail_argument("side", "must be >= 2 (2 bounding radius + min_gap) = " + std::to_string(2.0 * reach) +
-                              " for the minimum image, got " + std::to_string(side));
+  if (!(box.lengths.minCoeff() >= 2.0 * reach))
+    fail_argument("box.lengths", "every side must be >= 2 (2 bounding radius + min_gap) = " + std::to_string(2.0 * reach) +
+                                     " for the minimum image, got a side of " + std::to_string(box.lengths.minCoeff()));
+  if (box.lengths.x() != box.lengths.y())
+    fail_argument("box.lengths", "the columns' cross-section must be square (Lx = Ly), got " +
+                                     std::to_string(box.lengths.x()) + " x " + std::to_string(box.lengths.y()));
   if (count == 0) return {};
-  // A column's period must exceed `extent`; side >= 2 reach = 2 extent leaves room for >= 1.
+  const double side = box.lengths.x(), height = box.lengths.z();
+  // A column's period must exceed `extent`; height >= 2 reach = 2 extent leaves room for >= 1.
   const double extent = rod.length + 2.0 * rod.radius + min_gap;
-  const auto per_column = static_cast<std::size_t>(std::ceil(side / extent)) - 1;
+  const auto per_column = static_cast<std::size_t>(std::ceil(height / extent)) - 1;
   const std::size_t columns = (count + per_column - 1) / per_column;
   const auto k = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(columns))));
   const double spacing = side / static_cast<double>(k);
@@ -119,14 +126,25 @@ inline std::vector<Pose> periodic_aligned_columns(const Spherocylinder& rod, std
   for (std::size_t c = 0; c < columns; ++c) {
     // Rods of this column: count spread as evenly as the columns allow.
     const std::size_t here = count / columns + (c < count % columns ? 1 : 0);
-    const double period = side / static_cast<double>(here);
+    const double period = height / static_cast<double>(here);
     const double x = (static_cast<double>(sites[c] % k) + 0.5) * spacing + uniform(rng, -jitter, jitter);
     const double y = (static_cast<double>(sites[c] / k) + 0.5) * spacing + uniform(rng, -jitter, jitter);
-    const double offset = uniform(rng, 0.0, side);
+    const double offset = uniform(rng, 0.0, height);
     for (std::size_t r = 0; r < here; ++r)
-      poses.push_back(Pose{Vec3(x, y, std::fmod(offset + static_cast<double>(r) * period, side)), Quat::Identity()});
+      poses.push_back(Pose{Vec3(x, y, std::fmod(offset + static_cast<double>(r) * period, height)), Quat::Identity()});
   }
   return poses;
+}
+
+// The same in the periodic cube [0, side)^3; "side" named where it is too small.
+inline std::vector<Pose> periodic_aligned_columns(const Spherocylinder& rod, std::size_t count, double side,
+                                                  double min_gap, std::uint64_t seed) {
+  validate(rod);
+  const double reach = 2.0 * bounding_radius(rod) + std::max(min_gap, 0.0);
+  if (!(side >= 2.0 * reach))
+    fail_argument("side", "must be >= 2 (2 bounding radius + min_gap) = " + std::to_string(2.0 * reach) +
+                              " for the minimum image, got " + std::to_string(side));
+  return periodic_aligned_columns(rod, count, PeriodicBox{Vec3::Constant(side)}, min_gap, seed);
 }
 
 // Every centre scaled by `factor` about the origin, orientations kept: the affine rescaling
