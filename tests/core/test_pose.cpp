@@ -53,4 +53,31 @@ TEST(Pose, AcceptsQuaternionWithinTolerance) {
   EXPECT_NO_THROW(sc::validate(pose));
 }
 
+// is_valid checks |q|^2 against the squared bounds (no square root): the same answer as
+// | |q| - 1 | <= kUnitQuaternionTolerance away from the boundary, on either side, for every
+// direction of q; false for a NaN or infinite coefficient of q or x.
+TEST(Pose, IsValidIsTheUnitToleranceWithoutASquareRoot) {
+  const double tol = sc::kUnitQuaternionTolerance;
+  const sc::Quat axis = sc::Quat(0.5, -0.5, 0.5, 0.5);
+  for (const double offset : {-3.0, -1.01, -0.99, -0.5, 0.0, 0.5, 0.99, 1.01, 3.0}) {
+    sc::Pose pose;
+    pose.q.coeffs() = (1.0 + offset * tol) * axis.coeffs();
+    EXPECT_EQ(sc::is_valid(pose), std::abs(pose.q.norm() - 1.0) <= tol) << "offset " << offset;
+    EXPECT_EQ(sc::is_valid(pose), std::abs(offset) < 1.0) << "offset " << offset;
+  }
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  for (const double bad : {inf, -inf, nan})
+    for (int k = 0; k < 4; ++k) {
+      sc::Pose pose;
+      pose.q.coeffs()(k) = bad;
+      EXPECT_FALSE(sc::is_valid(pose)) << "q coefficient " << k << " = " << bad;
+      if (k < 3) {
+        sc::Pose at;
+        at.x(k) = bad;
+        EXPECT_FALSE(sc::is_valid(at)) << "x(" << k << ") = " << bad;
+      }
+    }
+  EXPECT_TRUE(sc::is_valid(sc::Pose{sc::Vec3(1e300, -1e300, 1e4), axis}));
+}
+
 }  // namespace pose_tests

@@ -936,8 +936,12 @@ class ContactStep {
   // Per body, whether M D lambda moves it (nonzero in its rows); a buffer kept between calls.
   const std::vector<char>& mark_moved(const VecX& MD_lambda) const {
     moved_.resize(trial_.size());
+    const double* rows = MD_lambda.data();
+    const auto dofs = static_cast<std::ptrdiff_t>(dofs_);
     parallel_for(static_cast<std::ptrdiff_t>(trial_.size()), [&](std::ptrdiff_t body) {
-      moved_[static_cast<std::size_t>(body)] = !MD_lambda.segment(body * dofs_, dofs_).isZero(0.0);
+      bool nonzero = false;  // a plain loop: Eigen's isZero on a segment of runtime size costs more than the pass
+      for (std::ptrdiff_t k = body * dofs; k < (body + 1) * dofs; ++k) nonzero |= rows[k] != 0.0;
+      moved_[static_cast<std::size_t>(body)] = nonzero;
     });
     return moved_;
   }

@@ -31,9 +31,14 @@ inline void require_unit(const Quat& q, std::string_view field) {
                              std::to_string(norm));
 }
 
+// x finite and | |q| - 1 | <= kUnitQuaternionTolerance, checked on |q|^2 (no square root; it
+// sits on every distance query and every advanced body): (1 - tol)^2 <= |q|^2 <= (1 + tol)^2,
+// false for a NaN or infinite coefficient (|q|^2 is then NaN or infinite).
 inline bool is_valid(const Pose& pose) {
-  return pose.x.allFinite() && pose.q.coeffs().allFinite() &&
-         std::abs(pose.q.norm() - 1.0) <= kUnitQuaternionTolerance;
+  constexpr double lo = (1.0 - kUnitQuaternionTolerance) * (1.0 - kUnitQuaternionTolerance);
+  constexpr double hi = (1.0 + kUnitQuaternionTolerance) * (1.0 + kUnitQuaternionTolerance);
+  const double n2 = pose.q.coeffs().squaredNorm();
+  return std::isfinite(pose.x.x()) && std::isfinite(pose.x.y()) && std::isfinite(pose.x.z()) && n2 >= lo && n2 <= hi;
 }
 
 // Throws std::invalid_argument naming "pose.x" or "pose.q" when the pose is unusable.
