@@ -8,7 +8,7 @@
 //                [--d-try-multiplier 1] [--d-try-rule absolute|relative] [--tol TOL] [--dt 0.01]
 //                [--cost formed|matrix-free]
 //                [--separation-margin 1e-3] [--end-of-step] [--pairs] [--output FILE] [--table1]
-//                [--objective sum|dissipation]
+//                [--objective sum|dissipation] [--substep-halvings K]
 //
 // Prints one JSON object per configuration (to --output if given, else stdout), then a
 // summary table per phi. --tol sets the eq. 29 TOL of the barrier and default solvers (without
@@ -25,11 +25,19 @@
 // x 1, at TOL 5e-6 (Fig. 5b with the lambda sum, Fig. 6 with --objective dissipation).
 // --objective: eq. 14's norm for the barrier solvers, sum of lambda (the default) or the
 // dissipation lambda^T D^T M D lambda.
+// --substep-halvings K: instead of one contact step, one TimeStepper step of --dt from each
+// configuration under its forces (U = M f at every sub-step's start), halved up to K times
+// where a contact step fails (TimeStepperOptions::max_substep_halvings; a step too crowded to
+// solve is refused at once, ContactStepOptions::max_flagged_pairs_per_body): per
+// configuration the sub-steps taken, the status, min d / d_hat over all pairs at the end
+// (brute force), the applications and the wall time of the whole step.
 #include <stokescontact/contact/solvers/contact_solver.hpp>
+#include <stokescontact/dynamics/time_stepper.hpp>
 #include <stokescontact/io/json.hpp>
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <limits>
 #include <map>
@@ -53,7 +61,7 @@ constexpr const char* kUsage =
     "                    [--d-try-rule absolute|relative] [--tol TOL]\n"
     "                    [--cost formed|matrix-free] [--separation-margin 1e-3] [--end-of-step] [--pairs]\n"
     "                    [--output FILE]\n"
-    "                    [--table1] [--objective sum|dissipation]\n";
+    "                    [--table1] [--objective sum|dissipation] [--substep-halvings K]\n";
 
 struct Options {
   int configs = 200;
@@ -65,6 +73,7 @@ struct Options {
   ex::StepSettings step;
   std::string output;
   bool table1 = false;
+  int substep_halvings = -1;  // >= 0: one TimeStepper step per configuration, halved up to this often
 };
 
 sc::MobilityCost parse_cost(const std::string& name) { return sc::mobility_cost_from_name(name, "--cost"); }
@@ -105,6 +114,10 @@ Options parse(int argc, char** argv) {
   o.step.options.validate();
   o.step.pair_details = args.flag("--pairs");
   o.output = args.text("--output", "");
+  o.substep_halvings = static_cast<int>(args.integer("--substep-halvings", -1, -1));
+  if (o.substep_halvings > 30) throw std::invalid_argument("--substep-halvings must lie in [0, 30]");
+  if (o.substep_halvings >= 0 && (o.table1 || o.step.pair_details || o.step.tol))
+    throw std::invalid_argument("--substep-halvings takes one stepper step per configuration: not with --table1, --pairs or --tol");
   args.reject_unknown();
   return o;
 }
@@ -173,6 +186,58 @@ void print_fig4_summary(const Options& o, const std::vector<std::pair<double, Ph
                 100.0 * s.respects / static_cast<double>(s.min_after.size()), ex::median(s.applications),
                 ex::maximum(s.applications), ex::median(s.wall), ex::median(s.nc), s.overlapping, s.deepest,
                 s.converged);
+}
+
+// --substep-halvings: one TimeStepper step per configuration (see the top).
+template <sc::MobilityOperator M>
+void run_stepper(const Options& o, M& mobility) {
+  ex::JsonLines sink(o.output);
+  std::printf("One stepper step of dt %g per configuration: %zu spheres, %s mobility, solver %s, cost %s, up to %d "
+              "halvings\n%5s %6s | %8s %9s | %12s | %6s | %9s | %s\n",
+              o.step.dt, o.spheres, ex::mobility_name(o.mobility), sc::contact_solver_name(o.solver).c_str(),
+              cost_name(o), o.substep_halvings, "phi", "config", "substeps", "flagged", "min d/d_hat", "apps",
+              "wall", "status");
+  for (const double phi : o.phis)
+    for (int c = 0; c < o.configs; ++c) {
+      const ex::SphereScene scene = ex::make_scene(fig4_scene(o, phi), o.seed + static_cast<std::uint64_t>(c));
+      sc::TimeStepperOptions options;
+      options.dt = o.step.dt;
+      options.d_hat = scene.d_hat;
+      options.d_try_multiplier = o.step.d_try_multiplier;
+      options.d_try_rule = o.step.d_try_rule;
+      options.max_substep_halvings = o.substep_halvings;
+      options.contact_step = o.step.options;
+      sc::TimeStepper<sc::Sphere, M> stepper({sc::Sphere{1.0}}, scene.packing.poses, mobility, o.solver, options);
+      stepper.set_external_forces(ex::stacked_forces(scene.forces, mobility.dofs_per_body()));
+      std::string status, message;
+      sc::StepDiagnostics d;
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        d = stepper.step();
+        status = sc::to_string(d.status);
+        message = d.message;
+      } catch (const std::runtime_error& e) {  // every halving failed: the stepper keeps Q_t
+        status = "failed_separation";
+        message = e.what();
+      }
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double min_ratio =
+          sc::minimum_pair_distance(sc::Sphere{1.0}, std::span<const sc::Pose>(stepper.poses())).distance / scene.d_hat;
+      sink.line("{\"record\": \"stepper\", \"seed\": " + std::to_string(scene.seed) + ", \"config\": " + std::to_string(c) +
+                    ", \"phi\": " + sc::json_number(phi) + ", \"spheres\": " + std::to_string(o.spheres) +
+                    ", \"mobility\": \"" + ex::mobility_name(o.mobility) + "\", \"solver\": \"" +
+                    sc::contact_solver_name(o.solver) + "\", \"cost\": \"" + cost_name(o) + "\", \"dt\": " +
+                    sc::json_number(o.step.dt) + ", \"max_substep_halvings\": " + std::to_string(o.substep_halvings) +
+                    ", \"substeps\": " + std::to_string(d.substeps) + ", \"flagged_pairs\": " +
+                    std::to_string(d.flagged_pairs) + ", \"min_d_over_d_hat_after\": " + sc::json_number(min_ratio) +
+                    ", \"mobility_applications\": " + std::to_string(d.mobility_applications) +
+                    ", \"iterations\": " + std::to_string(d.iterations) + ", \"wall_time_s\": " +
+                    sc::json_number(wall) + ", \"status\": \"" + status + "\", \"message\": " +
+                    sc::json_quoted(message) + "}");
+      std::printf("%5.2f %6d | %8zu %9zu | %12.6f | %6zu | %8.2fs | %s\n", phi, c, d.substeps, d.flagged_pairs,
+                  min_ratio, d.mobility_applications, wall, status.c_str());
+      std::fflush(stdout);
+    }
 }
 
 template <sc::MobilityOperator M>
@@ -317,7 +382,8 @@ int main(int argc, char** argv) {
       "fig4_spheres", kUsage, [&] { o = parse(argc, argv); },
       [&] {
         ex::SphereMobility mobility = ex::make_mobility(o.mobility, o.spheres);
-        std::visit([&](auto& m) { o.table1 ? run_table1(o, m) : run_fig4(o, m); }, mobility);
+        std::visit([&](auto& m) { o.table1 ? run_table1(o, m) : o.substep_halvings >= 0 ? run_stepper(o, m) : run_fig4(o, m); },
+                   mobility);
       });
 }
 

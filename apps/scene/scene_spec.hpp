@@ -225,7 +225,7 @@ inline MobilitySpec read_mobility(const JsonReader& r) {
 inline ContactSpec read_contact(const JsonReader& r, const SceneShape& shape) {
   r.known_keys({"d_hat", "d_try", "d_try_multiplier", "d_try_rule", "solver", "max_iterations", "directions",
                 "cost", "node_spacing", "whole_step", "separation_margin", "line_width", "line_angle",
-                "max_substep_halvings", "max_correction_turn", "broad_phase_skin"});
+                "max_substep_halvings", "max_correction_turn", "broad_phase_skin", "max_flagged_pairs_per_body"});
   ContactSpec c;
   const JsonReader d_hat = r.at("d_hat");
   if (d_hat.json().is_string()) {
@@ -279,6 +279,7 @@ inline ContactSpec read_contact(const JsonReader& r, const SceneShape& shape) {
   }
   if (const auto t = r.find("max_correction_turn")) c.step.max_correction_turn = t->positive();
   if (const auto k = r.find("broad_phase_skin")) c.step.broad_phase_skin = k->non_negative();
+  if (const auto k = r.find("max_flagged_pairs_per_body")) c.step.max_flagged_pairs_per_body = k->non_negative();
   c.line.width = std::get_if<Spherocylinder>(&shape) ? 2.0 * std::get<Spherocylinder>(shape).radius : 1.0;
   c.line.angle = 0.05;
   for (const char* key : {"line_width", "line_angle"})

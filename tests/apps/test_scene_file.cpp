@@ -111,6 +111,17 @@ TEST(SceneFile, BroadPhaseSkinIsRead) {
   expect_error(j, "contact.broad_phase_skin", "must be >= 0");
 }
 
+TEST(SceneFile, MaxFlaggedPairsPerBodyIsRead) {
+  json j = two_spheres();
+  EXPECT_EQ(apps::read_scene(j).contact.step.max_flagged_pairs_per_body, sc::ContactStepOptions{}.max_flagged_pairs_per_body);
+  j["contact"]["max_flagged_pairs_per_body"] = 0.0;  // never refused
+  EXPECT_EQ(apps::read_scene(j).contact.step.max_flagged_pairs_per_body, 0.0);
+  j["contact"]["max_flagged_pairs_per_body"] = 4.5;
+  EXPECT_EQ(apps::read_scene(j).contact.step.max_flagged_pairs_per_body, 4.5);
+  j["contact"]["max_flagged_pairs_per_body"] = -1.0;
+  expect_error(j, "contact.max_flagged_pairs_per_body", "must be >= 0");
+}
+
 TEST(SceneFile, BadInputNamesTheKeyPath) {
   json j = two_spheres();
   j["shape"]["radius"] = -1;

@@ -714,6 +714,48 @@ struct SphereSuspension {
   sc::ContactStepProblem<sc::Sphere> problem() const { return {shapes, packing.poses, U, 0.01, 0.01}; }
 };
 
+// A careless step: 200 spheres at packing 0.3 under |f| = 100 move about 5 radii in dt = 1
+// (100x the Fig. 4 step). Their trial motions flag more than 16 body pairs per body
+// (ContactStepOptions::max_flagged_pairs_per_body), and the step is refused before its
+// solve: failed_separation, saying so, no iteration, no application, lambda zero. At dt =
+// 0.01 the same scene flags 0.2 pairs per body: a limit just below its own count refuses it,
+// one just above solves it as the library's default does.
+TEST(ContactStep, RefusesACrowdedStepBeforeItsSolve) {
+  SphereSuspension suspension(200, 5);
+  sc::ContactStepProblem<sc::Sphere> careless = suspension.problem();
+  careless.dt = 1.0;
+  const sc::ContactStepResult refused =
+      sc::solve_contact_step_defect_correction(careless, suspension.mobility);
+  EXPECT_EQ(refused.status, sc::ContactStepStatus::failed_separation);
+  EXPECT_NE(refused.message.find("max_flagged_pairs_per_body = 16"), std::string::npos) << refused.message;
+  EXPECT_GT(refused.flagged_pairs, 16u * 200u);
+  EXPECT_EQ(refused.iterations, 0);
+  EXPECT_EQ(refused.mobility_applications, 0u);
+  EXPECT_EQ(refused.lambda.size(), static_cast<Eigen::Index>(refused.flagged_pairs));
+  EXPECT_TRUE(refused.lambda.isZero(0.0));
+  EXPECT_LT(refused.min_distance_ratio, 0.0);  // the trial step overlaps
+
+  const sc::ContactStepProblem<sc::Sphere> small = suspension.problem();
+  const sc::ContactStepResult solved =
+      sc::solve_contact_step_defect_correction(small, suspension.mobility);
+  ASSERT_EQ(solved.status, sc::ContactStepStatus::converged) << solved.message;
+  const double per_body = static_cast<double>(solved.flagged_pairs) / 200.0;  // spheres: one constraint per pair
+  ASSERT_GT(per_body, 0.1);
+  ASSERT_LT(per_body, 1.0);
+  sc::ContactStepOptions below, above;
+  below.max_flagged_pairs_per_body = 0.99 * per_body;
+  above.max_flagged_pairs_per_body = 1.01 * per_body;
+  EXPECT_EQ(sc::solve_contact_step_defect_correction(small, suspension.mobility, below).status,
+            sc::ContactStepStatus::failed_separation);
+  const sc::ContactStepResult same =
+      sc::solve_contact_step_defect_correction(small, suspension.mobility, above);
+  EXPECT_EQ(same.status, sc::ContactStepStatus::converged);
+  EXPECT_EQ(same.lambda, solved.lambda);
+  sc::ContactStepOptions off;
+  off.max_flagged_pairs_per_body = -1.0;
+  test_support::expect_rejects([&] { off.validate(); }, "ContactStepOptions.max_flagged_pairs_per_body");
+}
+
 // The end check at the first correction (DefectCorrectionOptions::early_end_check): 1000
 // spheres at packing 0.3 (seed 8, |f| = 100, free draining) whose converged first round leaves
 // a pair out that its forces bring below d_hat. Checked at the first corrected iterate (here

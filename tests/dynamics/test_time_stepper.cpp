@@ -20,6 +20,8 @@
 #include "stokescontact/dynamics/background_flow.hpp"
 #include "stokescontact/dynamics/time_stepper.hpp"
 #include "stokescontact/mobility/free_draining.hpp"
+#include "stokescontact/scenes/random.hpp"
+#include "stokescontact/scenes/sphere_packing.hpp"
 
 // The whole file in its own namespace: tests of one layer are compiled together (unity build).
 namespace time_stepper_tests {
@@ -621,6 +623,32 @@ TEST(TimeStepper, RejectsBadInputBeforeChangingAnything) {
     EXPECT_EQ(mobility.applications(), applications);
     for (std::size_t b = 0; b < 2; ++b) EXPECT_EQ(stepper.poses()[b].x, before[b].x);
   }
+}
+
+// The careless step of ContactStep.RefusesACrowdedStepBeforeItsSolve (200 spheres at packing
+// 0.3, |f| = 100, dt = 1: about 5 radii of motion) through the stepper: the refused interval
+// is halved at once, without a solve, and its halves (here dt / 2 each) are solved; the step
+// is committed with every gap held and every sub-step converged.
+TEST(TimeStepper, TakesACarelessStepInSubSteps) {
+  const std::size_t n = 200;
+  const sc::SpherePacking packing = sc::random_sequential_addition(n, 0.3, 5);
+  sc::Rng rng(5);
+  const std::vector<sc::Vec3> f = sc::random_forces(n, 100.0, rng);
+  sc::VecX F(3 * static_cast<Eigen::Index>(n));
+  for (std::size_t k = 0; k < n; ++k) F.segment<3>(3 * static_cast<Eigen::Index>(k)) = f[k];
+  auto mobility = sphere_mobility(n, 3);
+  sc::TimeStepperOptions o = options(1.0, 0.01);
+  o.max_substep_halvings = 8;
+  SphereStepper stepper({sc::Sphere{1.0}}, packing.poses, mobility, kDefault, o);
+  stepper.set_external_forces(F);
+  const sc::StepDiagnostics& d = stepper.step();
+  EXPECT_GE(d.substeps, 2);
+  EXPECT_EQ(d.status, sc::ContactStepStatus::converged) << d.message;
+  EXPECT_GE(brute_force_min_distance(stepper.poses()), 0.01 * (1.0 - kMargin));
+  EXPECT_GE(d.min_distance_ratio, 1.0 - kMargin);  // the least over the sub-steps' ends
+  double moved = 0.0;
+  for (std::size_t k = 0; k < n; ++k) moved = std::max(moved, (stepper.poses()[k].x - packing.poses[k].x).norm());
+  EXPECT_GT(moved, 2.0);  // the bodies did move several radii
 }
 
 }  // namespace

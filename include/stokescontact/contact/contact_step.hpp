@@ -166,6 +166,13 @@ struct ContactStepOptions {
   // that needs more reports failed_separation (the stepper then sub-steps). Bodies without
   // rotational degrees of freedom (spheres) never turn.
   double max_correction_turn = 0.5;
+  // A step whose flagged body pairs outnumber this many per body is refused before its solve
+  // (failed_separation, saying how many; the stepper then sub-steps): the trial motions carry
+  // the bodies through many neighbours each (equal spheres touch at most 12, 6 pairs per body;
+  // the dense suspensions of docs/results.md flag 1-7), where one linearised step cannot order
+  // the collisions, and the solve of tens of thousands of such pairs costs minutes (500
+  // spheres at 100x the Fig. 4 step: 31098 pairs, 51 s, failed). 0: never refused.
+  double max_flagged_pairs_per_body = 16.0;
   // The skin of the candidates the step's broad-phase queries share (CellList::keep_candidates):
   // negative, automatic (ContactStep::candidate_skin); 0, every query collects afresh. It sets
   // the cost of the queries, never their answer.
@@ -189,6 +196,7 @@ struct ContactStepOptions {
     if (!(max_correction_turn > 0.0))
       fail_argument("ContactStepOptions.max_correction_turn",
                     "must be > 0 radians, got " + std::to_string(max_correction_turn));
+    require_non_negative(max_flagged_pairs_per_body, "ContactStepOptions.max_flagged_pairs_per_body");
   }
 
   // Whether a scene of shape S uses d^S for its contact directions.
@@ -1036,6 +1044,24 @@ inline std::pair<double, Eigen::Index> max_correction_turn(const VecX& MD_lambda
   return out;
 }
 
+// Why a step is refused before its solve (ContactStepOptions::max_flagged_pairs_per_body),
+// or "" when it is not: its flagged body pairs (a pair held at several points, or through
+// several images, counts once) against the bodies.
+template <class Step>
+std::string refusal_of_crowded_step(const Step& step, const ContactStepOptions& options, std::size_t bodies) {
+  const double limit = options.max_flagged_pairs_per_body * static_cast<double>(bodies);
+  if (options.max_flagged_pairs_per_body == 0.0 || static_cast<double>(step.nc()) <= limit) return "";
+  const std::size_t pairs = step.flagged_body_pairs().size();
+  if (static_cast<double>(pairs) <= limit) return "";
+  std::ostringstream os;
+  os << "failed separation: the step was refused before its solve: " << pairs << " flagged body pairs for " << bodies
+     << " bodies (" << static_cast<double>(pairs) / static_cast<double>(bodies)
+     << " per body) exceed ContactStepOptions.max_flagged_pairs_per_body = " << options.max_flagged_pairs_per_body
+     << "; the trial motions carry the bodies through many neighbours each, beyond what one linearised step "
+        "holds: take a smaller step (TimeStepper halves it)";
+  return os.str();
+}
+
 inline VecX padded(const VecX& lambda, Eigen::Index size) {
   VecX out = VecX::Zero(size);
   out.head(std::min(size, lambda.size())) = lambda.head(std::min(size, lambda.size()));
@@ -1068,7 +1094,9 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   bool solver_gave_up = false;  // a round not converged with its own flagged pairs overlapping
   // Overlaps deeper than separation_margin d_hat count, found within a tenth of that.
   const double overlap_tolerance = std::max(0.1 * options.separation_margin, 1e-6) * problem.d_hat;
-  for (int round = 0;; ++round) {
+  const std::string refused = detail::refusal_of_crowded_step(step, options, problem.poses.size());
+  if (!refused.empty()) outcome.lambda = VecX::Zero(step.nc());  // the trial step, reported as it is
+  for (int round = 0; refused.empty(); ++round) {
     const int iterations = r.iterations;
     outcome = solve(step, detail::padded(outcome.lambda, step.nc()));
     lap(t.solve_s);
@@ -1157,7 +1185,10 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   std::tie(r.max_correction_turn, r.max_correction_turn_body) =
       detail::max_correction_turn(e.MD_lambda, step.dofs_per_body(), problem.dt);
   const bool over_turned = r.max_correction_turn > options.max_correction_turn;
-  if (!violating.empty() || !crossing.empty() || !beyond_box.empty() || over_turned) {
+  if (!refused.empty()) {
+    r.status = ContactStepStatus::failed_separation;
+    r.message = refused;
+  } else if (!violating.empty() || !crossing.empty() || !beyond_box.empty() || over_turned) {
     std::ostringstream os;
     os << "failed separation after " << r.guarantee_rounds << " guarantee round(s):";
     if (solver_gave_up) os << " the solver left flagged pairs overlapping (no further round);";
