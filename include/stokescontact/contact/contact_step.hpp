@@ -170,7 +170,7 @@ struct ContactStepOptions {
   // (failed_separation, saying how many; the stepper then sub-steps): the trial motions carry
   // the bodies through many neighbours each (equal spheres touch at most 12, 6 pairs per body;
   // the dense suspensions of docs/results.md flag 1-7), where one linearised step cannot order
-  // the collisions, and the solve of tens of thousands of such pairs costs minutes (500
+  // the collisions, and the solve of tens of thousands of such pairs costs tens of seconds (500
   // spheres at 100x the Fig. 4 step: 31098 pairs, 51 s, failed). 0: never refused.
   double max_flagged_pairs_per_body = 16.0;
   // The skin of the candidates the step's broad-phase queries share (CellList::keep_candidates):
