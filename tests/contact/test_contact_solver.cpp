@@ -118,6 +118,24 @@ TEST(ContactSolver, SolveContactStepRunsTheChosenSolver) {
 }
 
 // The names of 0.1 keep working for one release.
+// A step refused before its solve (ContactStepOptions::max_flagged_pairs_per_body; here 2
+// pairs of 3 bodies against a limit of 0.5 per body) is refused by every solver alike: the
+// default solver returns it without trying its fallbacks.
+TEST(ContactSolver, ARefusedStepIsNotSolvedAgain) {
+  const Row row;
+  auto mobility = row.mobility();
+  sc::ContactStepOptions options;
+  options.max_flagged_pairs_per_body = 0.5;
+  const sc::ContactStepResult r = sc::solve_contact_step(row.problem(), mobility, options);
+  EXPECT_EQ(r.status, sc::ContactStepStatus::failed_separation);
+  EXPECT_TRUE(r.refused);
+  EXPECT_TRUE(r.fallback.empty());
+  EXPECT_EQ(r.message.find("tried on this step"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("2 flagged body pairs for 3 bodies"), std::string::npos) << r.message;
+  options.max_flagged_pairs_per_body = 1.0;
+  EXPECT_EQ(sc::solve_contact_step(row.problem(), mobility, options).status, sc::ContactStepStatus::converged);
+}
+
 TEST(ContactSolver, DeprecatedNamesStillWork) {
   const Row row;
   auto m1 = row.mobility();

@@ -734,11 +734,13 @@ TEST(ContactStep, RefusesACrowdedStepBeforeItsSolve) {
   EXPECT_EQ(refused.lambda.size(), static_cast<Eigen::Index>(refused.flagged_pairs));
   EXPECT_TRUE(refused.lambda.isZero(0.0));
   EXPECT_LT(refused.min_distance_ratio, 0.0);  // the trial step overlaps
+  EXPECT_TRUE(refused.refused);
 
   const sc::ContactStepProblem<sc::Sphere> small = suspension.problem();
   const sc::ContactStepResult solved =
       sc::solve_contact_step_defect_correction(small, suspension.mobility);
   ASSERT_EQ(solved.status, sc::ContactStepStatus::converged) << solved.message;
+  EXPECT_FALSE(solved.refused);
   const double per_body = static_cast<double>(solved.flagged_pairs) / 200.0;  // spheres: one constraint per pair
   ASSERT_GT(per_body, 0.1);
   ASSERT_LT(per_body, 1.0);

@@ -277,6 +277,10 @@ struct ContactStepResult {
   // solved it again ("barrier-working-set", "lcp-newton"; solve_contact_step); empty otherwise.
   // The work counted above is that of every solve.
   std::string fallback;
+  // failed_separation before any solve: more flagged body pairs per body than
+  // ContactStepOptions::max_flagged_pairs_per_body. Every solver would refuse the same step,
+  // so no fallback is tried; a smaller step is the remedy.
+  bool refused = false;
 };
 
 // What a solver's core returns for one round: lambda and its own convergence.
@@ -1188,6 +1192,7 @@ ContactStepResult run_contact_step(const ContactStepProblem<S>& problem, M& mobi
   if (!refused.empty()) {
     r.status = ContactStepStatus::failed_separation;
     r.message = refused;
+    r.refused = true;
   } else if (!violating.empty() || !crossing.empty() || !beyond_box.empty() || over_turned) {
     std::ostringstream os;
     os << "failed separation after " << r.guarantee_rounds << " guarantee round(s):";

@@ -165,8 +165,9 @@ inline std::string trimmed(std::string message) {
   return message;
 }
 
-// A step the default solver failed (failed_separation) solved again by other solvers, in
-// order, the first answer that does not fail kept (DefectCorrectionOptions::far_root_fallback,
+// A step the default solver failed (failed_separation; not one refused before its solve,
+// ContactStepResult::refused, which every solver would refuse alike) solved again by other
+// solvers, in order, the first answer that does not fail kept (DefectCorrectionOptions::far_root_fallback,
 // lcp_sequence_fallback):
 //  - a far root (a correction turning a body by more than ContactStepOptions::
 //    max_correction_turn) by eq. 15 on the working set (barrier-working-set, the same
@@ -250,7 +251,7 @@ ContactStepResult solve_contact_step(const ContactStepProblem<S>& problem, M& mo
         using O = std::decay_t<decltype(o)>;
         if constexpr (std::is_same_v<O, DefectCorrectionOptions>) {
           ContactStepResult r = solve_contact_step_defect_correction(problem, mobility, options, o);
-          if (r.status == ContactStepStatus::failed_separation && (o.far_root_fallback || o.lcp_sequence_fallback))
+          if (r.status == ContactStepStatus::failed_separation && !r.refused && (o.far_root_fallback || o.lcp_sequence_fallback))
             return detail::solve_failed_step_again(problem, mobility, options, o, std::move(r));
           return r;
         } else if constexpr (std::is_same_v<O, LcpSequenceOptions>)
