@@ -693,6 +693,42 @@ TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
   EXPECT_NEAR(inexact.lambda_sum, reference.lambda_sum, kDefaultLambdaTolerance * reference.lambda_sum);
 }
 
+// Spheres in blocks mode: the chord method on the exact model at Q* with BBPGD LCPs
+// (DefectCorrectionOptions::bbpgd_on_exact_model, the default) against Newton with the Jacobian
+// at the iterate and minimum-map Newton LCPs (off), on a jammed packing whose working set is one
+// cluster of hundreds of pairs: both separated and complementary, the same force within the
+// corrections' stopping rule. The chord converges linearly, Newton faster: more corrections
+// (each free in blocks mode) show that the chord ran.
+TEST(ContactStep, BbpgdChordOnTheExactModelGivesNewtonsForces) {
+  std::mt19937_64 rng(12);
+  const sc::SpherePacking packing = sc::dense_packing(300, 0.6, rng());
+  const std::vector<sc::Vec3> forces = sc::random_forces(300, 100.0, rng);
+  SphereScene s;
+  s.poses = packing.poses;
+  s.d_hat = 1e-4;
+  s.dt = 0.01;
+  s.U.resize(900);
+  for (std::size_t i = 0; i < 300; ++i) s.U.segment<3>(3 * static_cast<Eigen::Index>(i)) = kMu * forces[i];
+  sc::DefectCorrectionOptions newton_options;
+  newton_options.bbpgd_on_exact_model = false;
+  auto m0 = s.mobility();
+  auto m1 = s.mobility();
+  const sc::ContactStepResult chord = sc::solve_contact_step_defect_correction(s.problem(), m0);
+  const sc::ContactStepResult newton = sc::solve_contact_step_defect_correction(s.problem(), m1, {}, newton_options);
+  ASSERT_GE((newton.lambda.array() > 0.0).count(), 100);  // a network, not a few pairs
+  for (const sc::ContactStepResult* r : {&chord, &newton}) {
+    EXPECT_EQ(r->status, sc::ContactStepStatus::converged) << r->message;
+    EXPECT_EQ(r->cost, sc::MobilityCost::blocks);
+    EXPECT_GE(r->min_distance_ratio, 1.0);
+    EXPECT_LE(r->complementarity_residual, 1e-3);
+    expect_third_law(*r, 3);
+  }
+  EXPECT_GT(chord.iterations, newton.iterations);
+  ASSERT_EQ(chord.lambda.size(), newton.lambda.size());
+  EXPECT_LE((chord.lambda - newton.lambda).lpNorm<Eigen::Infinity>(), 1e-3 * newton.lambda_max);
+  EXPECT_NEAR(chord.lambda_sum, newton.lambda_sum, kDefaultLambdaTolerance * newton.lambda_sum);
+}
+
 // N unit spheres at packing 0.3 (random sequential addition) under random forces |f| = 100,
 // both of seed `seed`, free draining, dt = d_hat = 0.01: the scene of
 // examples/contact_step_scaling (which takes seed N).
@@ -870,9 +906,11 @@ TEST(ContactStep, BroadPhaseSkinSetsTheCostNotTheAnswer) {
 TEST(ContactStep, AutomaticCostModeFollowsTheModelAndBlocksNeedsBlocks) {
   const SphereScene s = random_spheres(12, 30, 8.0, 10.0);
   auto free_draining = s.mobility();
-  // (the model at Q* in both modes: blocks mode's default is the Jacobian at the iterate)
+  // (the model at Q* and Newton's LCPs in both modes: blocks mode's default for spheres is
+  // BBPGD on it, for other convex bodies the Jacobian at the iterate)
   sc::DefectCorrectionOptions at_trial;
   at_trial.jacobian_at_iterate = false;
+  at_trial.bbpgd_on_exact_model = false;
   const sc::ContactStepResult blocks = sc::solve_contact_step_defect_correction(s.problem(), free_draining, {}, at_trial);
   EXPECT_EQ(blocks.cost, sc::MobilityCost::blocks);
   EXPECT_EQ(blocks.mobility_applications, 0u);
@@ -982,6 +1020,10 @@ TEST(ContactStep, RejectsBadInputNamingTheFieldAndChangesNothing) {
   def = {};
   def.lcp_tolerance_max = 1e-13;  // below lcp.tolerance
   expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(p, m, {}, def); }, "DefectCorrectionOptions.lcp_tolerance_max");
+  def = {};
+  def.exact_model_lcp_tolerance_max = 1.0;
+  expect_rejects([&] { (void)sc::solve_contact_step_defect_correction(p, m, {}, def); },
+                 "DefectCorrectionOptions.exact_model_lcp_tolerance_max");
   sc::FreeDrainingMobility wrong(sc::sphere_mobility(sc::Sphere{1.0}, 1.0), 3, 3);  // 3 bodies for 2 poses
   expect_rejects([&] { (void)sc::solve_contact_step_lcp_sequence(p, wrong); }, "mobility");
   EXPECT_EQ(m.applications(), 0u);

@@ -231,6 +231,7 @@ ContactStepResult solve_contact_step_barrier(const ContactStepProblem<S>& proble
     DefectCorrectionOptions corrections;
     corrections.tol = barrier.tol;
     corrections.lcp_forcing = 0.0;  // every LCP to 1e-12: its answer starts SLSQP, whose dense solve is the cost
+    corrections.bbpgd_on_exact_model = false;  // eq. 15 is not an LCP: the Jacobian at the iterate serves it
     const detail::WorkingSetBarrier subproblem{detail::nlopt_algorithm(barrier.optimizer),
                                                barrier.objective == BarrierObjective::dissipation,
                                                barrier.max_evaluations, corrections.lcp};
