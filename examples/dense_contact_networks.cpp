@@ -15,6 +15,10 @@
 // jammed: N spheres compressed to each packing fraction (dense_packing, seed 1, smallest gaps
 //   ~1e-3), random forces |f| = 100, free draining, dt = 0.01, d_hat = 1e-4: one contact step
 //   per solver; pushed pairs, applications, wall time, min d / d_hat after, complementarity.
+//   An LCP sequence's name with "-polished" (lcp-bbpgd-polished, ...) runs it on to the
+//   default solver's own end, Broms eq. 29 at d >= d_hat (LcpSequenceOptions::tol and margin
+//   set to the DefectCorrectionOptions defaults): a complementary baseline, where the plain
+//   sequence stops at its first separated iterate.
 // One JSON object per line (to --output if given, else stdout) and a readable summary.
 #include <stokescontact/contact/solvers/contact_solver.hpp>
 #include <stokescontact/io/json.hpp>
@@ -25,7 +29,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
+#include <string_view>
+#include <variant>
 #include <vector>
 
 #include "common/cli.hpp"
@@ -110,11 +117,25 @@ bool ball(ex::JsonLines& sink, std::size_t n, int steps, sc::MobilityCost mode) 
   return ok;
 }
 
+constexpr std::string_view kPolished = "-polished";
+
+// The solver `name` names: the library's (contact_solver_from_name), or an LCP sequence's name
+// with kPolished, the sequence taken to complementarity.
+sc::ContactSolver solver_named(const std::string& name) {
+  if (!name.ends_with(kPolished)) return sc::contact_solver_from_name(name);
+  sc::ContactSolver solver = sc::contact_solver_from_name(name.substr(0, name.size() - kPolished.size()));
+  auto* sequence = std::get_if<sc::LcpSequenceOptions>(&solver);
+  if (!sequence) throw std::invalid_argument("--solvers: '" + name + "': only an LCP sequence (lcp-*) can be polished");
+  sequence->tol = sc::DefectCorrectionOptions{}.tol;
+  sequence->margin = sc::DefectCorrectionOptions{}.margin;
+  return solver;
+}
+
 bool jammed(ex::JsonLines& sink, std::size_t n, const std::vector<double>& phis, const std::vector<std::string>& solvers,
             sc::MobilityCost mode) {
   const double dt = 0.01, d_hat = 1e-4, force = 100.0;
   std::printf("\nJammed packings: %zu spheres, |f| = %g, free draining, dt = %g, d_hat = %g, %s\n"
-              "%6s %6s | %-11s | %7s %7s | %6s %5s | %10s | %12s | %9s | %s\n",
+              "%6s %6s | %-18s | %7s %7s | %6s %5s | %10s | %12s | %9s | %s\n",
               n, force, dt, d_hat, sc::mobility_cost_name(mode), "phi", "gap", "solver", "Nc", "pushed", "apps", "its", "wall", "min d/d_hat",
               "compl.", "status");
   bool ok = true;
@@ -130,10 +151,10 @@ bool jammed(ex::JsonLines& sink, std::size_t n, const std::vector<double>& phis,
       sc::ContactStepOptions options;
       options.cost = mode;
       const sc::ContactStepResult r =
-          sc::solve_contact_step(problem, mobility, options, sc::contact_solver_from_name(name));
+          sc::solve_contact_step(problem, mobility, options, solver_named(name));
       sink.line(record("jammed", name, r) + ", \"phi\": " + sc::json_number(packing.phi) + ", \"min_gap\": " +
                 sc::json_number(packing.min_gap) + "}");
-      std::printf("%6.3f %6.0e | %-11s | %7zu %7zu | %6zu %5d | %9.3fs | %12.6f | %9.2e | %s\n", packing.phi,
+      std::printf("%6.3f %6.0e | %-18s | %7zu %7zu | %6zu %5d | %9.3fs | %12.6f | %9.2e | %s\n", packing.phi,
                   packing.min_gap, name.c_str(), r.flagged_pairs, pushed_pairs(r), r.mobility_applications,
                   r.iterations, r.wall_time_s, r.min_distance_ratio, r.complementarity_residual,
                   std::string(sc::to_string(r.status)).c_str());
@@ -168,7 +189,7 @@ Options parse(int argc, char** argv) {
   o.steps = static_cast<int>(args.integer("--steps", 300, 1));
   o.phis = args.numbers("--phi", {0.45, 0.5, 0.55, 0.6}, 0.0);
   o.solvers = args.list("--solvers", {"default", "lcp-newton", "lcp-bbpgd", "lcp-apgd"});
-  for (const std::string& s : o.solvers) sc::contact_solver_from_name(s);
+  for (const std::string& s : o.solvers) solver_named(s);
   for (const std::string& c : args.list("--cost", {"blocks", "matrix-free"}))
     o.costs.push_back(sc::mobility_cost_from_name(c, "--cost"));
   o.output = args.text("--output", "");

@@ -183,14 +183,16 @@ struct DefectCorrectionOptions {
   // does not converge. Newton with the Jacobian at the iterate needs fewer corrections (4
   // against 8-9 on jammed packings), but its LCPs are not symmetric and need GMRES and sparse
   // factorisations, so each costs more than the extra corrections, which are free in blocks
-  // mode (no mobility application). Jammed spheres (1000, phi 0.45-0.6): 1.3-1.4x faster per
-  // step, complementary to 1e-4 where Newton left 1e-3-5e-3 at 0.55-0.6; the inward-driven ball
-  // 1.4x (docs/results.md, "BBPGD on the exact model of spheres").
+  // mode (no mobility application). Jammed spheres (1000, phi 0.45-0.6), with the ceiling
+  // below: 1.3-1.6x faster per step, complementary to 1.1-1.4e-4 where Newton left up to
+  // 4.5e-3; the inward-driven ball 2.0x; 1e5 spheres at packing 0.3 1.05-1.07x
+  // (docs/results.md, "BBPGD on the exact model of spheres").
   bool bbpgd_on_exact_model = true;
   // Such a round's ceiling on its LCPs' tolerance (lcp_tolerance_max for the others): the
   // chord's corrections are free, so a looser first LCP costs nothing but a correction, and
   // BBPGD's iterations on it were most of the step. 1e-6 against 1e-8: the ball 1.25x faster
-  // with the same 850 corrections, jammed packings 1.2x (docs/results.md, same section).
+  // with the same 850 corrections, jammed packings 1.2x at 0.55-0.6 (docs/results.md, same
+  // section).
   double exact_model_lcp_tolerance_max = 1e-6;
   // A step this solver fails is solved again through solve_contact_step (contact_solver.hpp,
   // solve_failed_step_again), the first answer that does not fail kept: a far root (its
