@@ -662,12 +662,11 @@ TEST(ContactStep, JammedClusterIsSeparatedByTheWorkingSetBarrier) {
   }
 }
 
-// Inexact corrections (DefectCorrectionOptions::lcp_forcing: each working-set LCP solved only
-// to a tolerance that follows the corrections' convergence) against every LCP solved to 1e-12,
-// on a jammed packing whose working set is one cluster of hundreds of pairs: both separated
-// and complementary, the same force within the corrections' stopping rule.
-TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
-  std::mt19937_64 rng(11);
+// 300 unit spheres compressed to packing 0.6 (dense_packing, smallest gaps ~1e-3) under random
+// forces |f| = 100, both drawn from `seed`; dt = 0.01, d_hat = 1e-4: a jammed packing whose
+// working set is one cluster of hundreds of pairs.
+SphereScene jammed_spheres(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
   const sc::SpherePacking packing = sc::dense_packing(300, 0.6, rng());
   const std::vector<sc::Vec3> forces = sc::random_forces(300, 100.0, rng);
   SphereScene s;
@@ -676,6 +675,15 @@ TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
   s.dt = 0.01;
   s.U.resize(900);
   for (std::size_t i = 0; i < 300; ++i) s.U.segment<3>(3 * static_cast<Eigen::Index>(i)) = kMu * forces[i];
+  return s;
+}
+
+// Inexact corrections (DefectCorrectionOptions::lcp_forcing: each working-set LCP solved only
+// to a tolerance that follows the corrections' convergence) against every LCP solved to 1e-12,
+// on a jammed packing whose working set is one cluster of hundreds of pairs: both separated
+// and complementary, the same force within the corrections' stopping rule.
+TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
+  const SphereScene s = jammed_spheres(11);
   sc::DefectCorrectionOptions exact;
   exact.lcp_forcing = 0.0;
   auto m0 = s.mobility();
@@ -700,15 +708,7 @@ TEST(ContactStep, InexactCorrectionsGiveTheExactCorrectionsForces) {
 // corrections' stopping rule. The chord converges linearly, Newton faster: more corrections
 // (each free in blocks mode) show that the chord ran.
 TEST(ContactStep, BbpgdChordOnTheExactModelGivesNewtonsForces) {
-  std::mt19937_64 rng(12);
-  const sc::SpherePacking packing = sc::dense_packing(300, 0.6, rng());
-  const std::vector<sc::Vec3> forces = sc::random_forces(300, 100.0, rng);
-  SphereScene s;
-  s.poses = packing.poses;
-  s.d_hat = 1e-4;
-  s.dt = 0.01;
-  s.U.resize(900);
-  for (std::size_t i = 0; i < 300; ++i) s.U.segment<3>(3 * static_cast<Eigen::Index>(i)) = kMu * forces[i];
+  const SphereScene s = jammed_spheres(12);
   sc::DefectCorrectionOptions newton_options;
   newton_options.bbpgd_on_exact_model = false;
   auto m0 = s.mobility();
