@@ -662,6 +662,59 @@ TEST(ContactStep, JammedClusterIsSeparatedByTheWorkingSetBarrier) {
   }
 }
 
+// The far-root search's shortcut (detail::ray_held_below_target) against the samples it saves:
+// where it says the ray s lambda, s in (0, 15/16], is held below the target, no sample
+// separates. Two spheres head on (trial gap -0.03; their gap affine in lambda) at lambda
+// overshooting the first crossing by 1, 1.01 and 10 (crossing at s = 1 / overshoot: the last
+// two are a nearer crossing, which only 10 puts below 15/16); then random scenes of 30
+// spheres at their converged lambda, where each pair's gap is convex in s; and the two spheres
+// in a periodic box, where the shortcut is not taken.
+TEST(ContactStep, ARayHeldBelowTheTargetHasNoSeparatedSample) {
+  const double margin = 1e-4, s_max = 15.0 / 16.0;
+  const auto samples_separate = [&](const auto& step, const sc::ContactEvaluation& e, double target) {
+    for (int j = 1; j <= 15; ++j)
+      if (step.separated_at(sc::VecX(j / 16.0 * e.MD_lambda), target)) return true;
+    return false;
+  };
+  const SphereScene s = head_on(0.02, 2.5);
+  auto m = s.mobility();
+  sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility> step(s.problem(), m, {});
+  ASSERT_EQ(step.nc(), 1);
+  const double target = s.d_hat * (1.0 + margin), d0 = step.pairs()[0].points.distance;
+  const double slope = sc::ContactEvaluation(step.evaluate(sc::VecX::Ones(1))).distances(0) - d0;
+  ASSERT_LT(d0, 0.0);
+  for (const double overshoot : {1.0, 1.01, 10.0}) {
+    SCOPED_TRACE("overshoot " + std::to_string(overshoot));
+    const sc::ContactEvaluation e = step.evaluate(sc::VecX::Constant(1, overshoot * (target - d0) / slope));
+    const bool held = sc::detail::ray_held_below_target(step, e.distances, target, s_max);
+    EXPECT_EQ(held, overshoot < 2.0);
+    EXPECT_EQ(samples_separate(step, e, target), !held);
+  }
+  int held_scenes = 0;
+  for (const std::uint64_t seed : {1u, 2u, 3u, 4u, 5u}) {
+    const SphereScene r = random_spheres(seed, 30, 8.0, 10.0);
+    auto mr = r.mobility();
+    const sc::ContactStepResult solved = sc::solve_contact_step_defect_correction(r.problem(), mr);
+    ASSERT_EQ(solved.status, sc::ContactStepStatus::converged) << solved.message;
+    if (solved.lambda_max == 0.0) continue;
+    sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility> at(r.problem(), mr, {});
+    ASSERT_EQ(at.nc(), solved.lambda.size());
+    const double t = r.d_hat * (1.0 + margin);
+    const sc::ContactEvaluation e = at.evaluate(solved.lambda);
+    if (sc::detail::ray_held_below_target(at, e.distances, t, s_max)) {
+      ++held_scenes;
+      EXPECT_FALSE(samples_separate(at, e, t)) << "seed " << seed;
+    }
+  }
+  EXPECT_GT(held_scenes, 0);
+  sc::ContactStepProblem<sc::Sphere> periodic = s.problem();
+  periodic.box = sc::PeriodicBox{sc::Vec3::Constant(20.0)};
+  auto mp = s.mobility();
+  sc::ContactStep<sc::Sphere, sc::FreeDrainingMobility> in_box(periodic, mp, {});
+  const sc::ContactEvaluation e = in_box.evaluate(sc::VecX::Constant(1, (target - d0) / slope));
+  EXPECT_FALSE(sc::detail::ray_held_below_target(in_box, e.distances, target, s_max));
+}
+
 // 300 unit spheres compressed to packing 0.6 (dense_packing, smallest gaps ~1e-3) under random
 // forces |f| = 100, both drawn from `seed`; dt = 0.01, d_hat = 1e-4: a jammed packing whose
 // working set is one cluster of hundreds of pairs.

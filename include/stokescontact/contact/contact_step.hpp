@@ -758,6 +758,9 @@ class ContactStep {
   // (DTryRule::relative, find_pairs_relative): then only the flagged pairs and the pairs of
   // bodies a correction moves can cross along a corrected motion (CrossingScope).
   bool unflagged_pairs_stay_clear() const { return unflagged_stay_clear_; }
+  // Whether flagged pair k is a contact carried from inside the step (measured by its gap
+  // there), not measured at Q* like the others (pairs()[k].points: its distance at Q*).
+  bool carried(std::size_t k) const { return carried_[k].has_value(); }
 
   // The bodies of the flagged pairs (i < j), each pair once, sorted.
   std::vector<BodyPair> flagged_body_pairs() const {

@@ -432,6 +432,28 @@ struct ForceRay {
   }
 };
 
+// Whether no sample of the ray s lambda, s in (0, s_max], can separate, known without
+// evaluating one. Bodies that only translate, convex shapes, distances d^P, no periodic box
+// (spheres in free space): along the ray each flagged pair's distance is a convex function of
+// s (the signed distance of two convex bodies is a maximum of affine functions of their
+// relative translation, and the ray translates them linearly in s), so a pair at d_0 < target
+// at Q* (s = 0) and at d_1 at s = 1 (`distances`) stays below the target for
+// s < (target - d_0) / (target - d_0 + max(0, d_1 - target)). When that bound reaches s_max
+// for some pair, the search for a nearer crossing (a far root of eq. 27) has nothing to find.
+// (In a periodic box a pair's nearest image may change along the ray; it is not used there.)
+template <Shape S, MobilityOperator M>
+bool ray_held_below_target(const ContactStep<S, M>& step, const VecX& distances, double target, double s_max) {
+  if (step.dofs_per_body() != 3 || !S::convex || step.options().template surface_directions<S>() ||
+      step.problem().box)
+    return false;
+  for (Eigen::Index k = 0; k < step.nc(); ++k) {
+    if (step.carried(static_cast<std::size_t>(k))) continue;
+    const double below = target - step.pairs()[static_cast<std::size_t>(k)].points.distance;
+    if (below > 0.0 && below >= s_max * (below + std::max(0.0, distances(k) - target))) return true;
+  }
+  return false;
+}
+
 // The first crossing of the target by the flagged distances on the ray, s in (0, s_max]: the
 // smallest of `samples` equal steps whose min d >= target, refined by bisection against the
 // step before it to a relative width `tol`; the returned s separates. None when no sample
@@ -801,8 +823,9 @@ ContactSolveOutcome solve_defect_correction_round(ContactStep<S, M>& step, VecX 
       // A smaller separating force on the same ray (a far root of a non-monotone d): the
       // samples before s = 1 only (s = j / ray_samples, j < ray_samples), so a monotone d
       // costs them and nothing else (no bisection towards s = 1, whose crossing is lambda's).
-      if (search_rays && lambda.sum() > 0.0) {
-        const int below_one = options.ray_samples - 1;
+      const int below_one = options.ray_samples - 1;
+      if (search_rays && lambda.sum() > 0.0 &&
+          !ray_held_below_target(step, e.distances, target, double(below_one) / options.ray_samples)) {
         const ForceRay ray = ForceRay::through(lambda, e.MD_lambda);
         const std::optional<double> s =
             ray_first_crossing(step, ray, double(below_one) / options.ray_samples, target, below_one, ray_tol);
