@@ -66,6 +66,9 @@
 //    separates, and then back to the first crossing the same way (ray_first_crossing). That
 //    ray scales only the forces of the clusters (pairs linked through shared bodies) not yet
 //    separated; the separated clusters keep theirs (stalled_cluster_ray).
+//    Between bodies that only translate (convex shapes, free space) a pair's gap is convex
+//    along the ray, and the samples are skipped where one pair's gap holds the ray below the
+//    target past the last sample (ray_held_below_target).
 //
 // Stopping rule (Broms eq. 29 form): at an iterate whose flagged pairs all have d >= d_hat, stop when
 // the next correction would change lambda by less than tol ||lambda||_inf; that iterate is
